@@ -1,0 +1,1 @@
+"""PWM-PID control (Eq. 12) and the agonist-antagonist strategies (Sec. 2.6, 4)."""

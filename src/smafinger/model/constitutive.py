@@ -1,0 +1,95 @@
+"""Eqs. (7)-(8): rate-form constitutive law with the spring-slack tendon in series.
+
+Eq. (7a) with theta_T = 0 (Sec. 3), eps_t = xi eps_R and Omega = -eps_R D gives, for wire and
+spring in series (Eq. 7b),
+
+    dsigma/dt = D_eq (d eps/dt - eps_R d xi/dt),
+    D_eq = K_eq L_w / S_w,  K_eq = K_s K_D / (K_s + K_D),  K_D = D S_w / L_w   (Eq. 8)
+
+with D = D_A + xi (D_M - D_A). The spring-slack element: the spring stiffens from
+``slack_band`` before the slack point (``slack`` beyond the initial elongation) as
+K_s,eff = K_S + cosh(f dx) - 1 [N/m], dx in mm (MODEL-NOTES). A tendon only pulls: the
+stress never goes negative.
+"""
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def youngs_modulus(xi, D_A, D_M):
+    """D = D_A + xi (D_M - D_A) (Eq. 7a)."""
+    return D_A + xi * (D_M - D_A)
+
+
+@njit(cache=True)
+def spring_stiffness(x, K_S, x_limit, fact):
+    """K_s,eff [N/m] at spring elongation x [m]; stiffening beyond x_limit (dx in mm)."""
+    dx_mm = 1000.0 * (x - x_limit)
+    if dx_mm <= 0.0:
+        return K_S
+    return K_S + math.cosh(fact * dx_mm) - 1.0
+
+
+@njit(cache=True)
+def spring_force(x, K_S, x_limit, fact):
+    """F_s(x) = integral of K_s,eff: K_S x + (sinh(f dx) - f dx) / (1000 f) beyond x_limit."""
+    if x <= 0.0:
+        return 0.0
+    dx_mm = 1000.0 * (x - x_limit)
+    if dx_mm <= 0.0 or fact == 0.0:
+        return K_S * x
+    u = fact * dx_mm
+    return K_S * x + (math.sinh(u) - u) / (1000.0 * fact)
+
+
+@njit(cache=True)
+def spring_elongation(F, K_S, x_limit, fact):
+    """Inverse of :func:`spring_force` (Newton from the linear guess; F >= 0)."""
+    if F <= 0.0:
+        return 0.0
+    x = F / K_S
+    if x <= x_limit or fact == 0.0:
+        return x
+    for _ in range(60):
+        r = spring_force(x, K_S, x_limit, fact) - F
+        k = spring_stiffness(x, K_S, x_limit, fact)
+        step = r / k
+        x -= step
+        if abs(step) < 1e-15:
+            break
+    return x
+
+
+@njit(cache=True)
+def equivalent_modulus(K_s, D, S_w, L_w):
+    """D_eq = K_eq L_w / S_w with K_eq = K_s K_D / (K_s + K_D) (Eq. 8) [Pa]."""
+    K_D = D * S_w / L_w
+    return K_s * K_D / (K_s + K_D) * L_w / S_w
+
+
+@njit(cache=True)
+def stress_rate(D_eq, deps_dt, eps_R, dxi_dT, dxi_dsigma, dT_dt, sigma):
+    """dsigma/dt of Eq. (7b), solved together with dxi/dt = xi_T T' + xi_sigma sigma'.
+
+    A slack tendon (sigma <= 0) cannot go into compression: its rate is then floored at 0.
+    """
+    rate = D_eq * (deps_dt - eps_R * dxi_dT * dT_dt) / (1.0 + D_eq * eps_R * dxi_dsigma)
+    if sigma <= 0.0 and rate < 0.0:
+        return 0.0
+    return rate
+
+
+@njit(cache=True)
+def secant_modulus_authors(eps_el, D, K_S, x_limit, fact, S_w, L_w):
+    """D_eq of the authors' 2020 model at total elastic strain eps_el (wire + spring).
+
+    The elastic elongation splits between wire and spring with the linear spring stiffness;
+    the spring's share sets K_s,eff, which then gives the secant D_eq (Eq. 8).
+    Returns (D_eq, spring elongation [m]).
+    """
+    K_D = D * S_w / L_w
+    x_spring = K_D * L_w * eps_el / (K_D + K_S)
+    K_s = spring_stiffness(x_spring, K_S, x_limit, fact)
+    return equivalent_modulus(K_s, D, S_w, L_w), x_spring

@@ -1,0 +1,50 @@
+"""Named parameter sets, TOML files and overrides.
+
+>>> from smafinger.parameters import get
+>>> p = get("paper2010")
+>>> p.h0_heating_W_m2K
+20.0
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Callable
+
+from . import authors2020, paper2010
+from .base import ParameterError, ParameterSet, load_toml
+
+REGISTRY: dict[str, Callable[[], ParameterSet]] = {
+    "paper2010": paper2010.parameters,
+    "paper2010-table2": paper2010.table2,
+    "authors2020": authors2020.parameters,
+}
+
+
+def names() -> list[str]:
+    return sorted(REGISTRY)
+
+
+def get(name: str) -> ParameterSet:
+    """A named parameter set."""
+    try:
+        return REGISTRY[name]()
+    except KeyError:
+        raise ParameterError(
+            f"unknown parameter set {name!r} (known: {', '.join(names())}, or a .toml file)"
+        ) from None
+
+
+def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
+    """A set from a name, a TOML path, or a set."""
+    if isinstance(spec, ParameterSet):
+        return spec
+    s = str(spec)
+    if s in REGISTRY:
+        return get(s)
+    if s.endswith(".toml") or Path(s).exists():
+        return load_toml(s, get)
+    return get(s)
+
+
+__all__ = ["ParameterError", "ParameterSet", "get", "names", "resolve", "load_toml", "REGISTRY"]
