@@ -21,19 +21,19 @@ from ..control.strategies import (
     AUTO, BOTH, COOPERATIVE, INDEPENDENT, LOWER, NONE, OPEN_LOOP, RELEASE_XI, UPPER,
     actuator_commands, independent_agonist,
 )
-from ..model.kinetics import HOLD, branch_of, branch_start
+from ..model.kinetics import HOLD, branch_start, next_branch
 from ..model.layout import (
     P_A_F0, P_A_S0, P_C_DF_c, P_C_DF_h, P_K_I, P_K_P, P_K_V, P_L_w, P_M_F0, P_M_S0, P_M_SF,
     P_T_init, P_V_H, P_V_L, P_c_A, P_c_M, P_damping_enabled, P_eps_tot0_l, P_eps_tot0_u,
-    P_integral_never, P_keep_on_cooling, P_omega_stick, P_path0_l, P_path0_u, P_sigma0_l,
-    P_sigma0_u, P_stick_initial_only, P_stress_algebraic, P_theta0, P_xi_init, P_xlim_l,
+    P_anti_windup, P_integral_never, P_keep_on_cooling, P_omega_stick, P_path0_l, P_path0_u, P_sigma0_l,
+    P_sigma0_u, P_reversal, P_stick_initial_only, P_stress_algebraic, P_theta0, P_xi_init, P_xlim_l,
     P_xlim_u,
 )
 from ..model.kinematics import both_tendons
 from ..model.layout import P_a0_l, P_a0_u, P_a1, P_a2, P_a4, P_a5, P_r
 from .rhs import (
     A_BL, A_BU, A_ME, A_SL, A_SU, A_XIL, A_XIU, A_XL, A_XU, D_BRL, D_BRU, D_CDF, D_HEATL,
-    D_HEATU, D_STL, D_STU, D_STUCK, D_THF, D_VL, D_VU, D_XHL, D_XHU, N_AUX, N_DISC, N_STATE,
+    D_HEATU, D_INTON, D_STL, D_STU, D_STUCK, D_THF, D_VL, D_VU, D_XHL, D_XHU, N_AUX, N_DISC, N_STATE,
     Y_EL, Y_EU, Y_INT, Y_OMEGA, Y_SL, Y_SU, Y_THETA, Y_TL, Y_TU, _xi, algebraic_stress,
     evaluate, integrate_rest, wire_temperature_rate,
 )
@@ -77,9 +77,9 @@ def _wire_xi_sigma(y, d, p, upper):
 
 
 @njit(cache=True)
-def _update_branch(d, i_br, i_st, i_xh, dT, xi_now, T, sigma, p):
-    """Select the kinetics branch from dT/dt; re-solve the start value on a change."""
-    nb = branch_of(dT)
+def _update_branch(d, i_br, i_st, i_xh, dT, xi_now, T, sigma, p, turn, side):
+    """Select the kinetics branch; re-solve the start value on a change (minor loops)."""
+    nb, turn[side] = next_branch(int(d[i_br]), dT, T, turn[side], p[P_reversal])
     if nb != int(d[i_br]):
         if nb == HOLD:
             d[i_xh] = xi_now
@@ -112,6 +112,8 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
     d[D_XHL] = p[P_xi_init]
     d[D_STU] = p[P_xi_init]
     d[D_STL] = p[P_xi_init]
+    d[D_INTON] = 1.0
+    turn = np.array([p[P_T_init], p[P_T_init]])
     work = np.zeros((5, N_STATE))
     aux = np.zeros(N_AUX)
     xi_u, sig_u = _wire_xi_sigma(y, d, p, True)
@@ -195,6 +197,8 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
                 en_u = pending == UPPER
                 en_l = pending == LOWER
                 force_update = True
+                if p[P_integral_never] == 0.0:
+                    y[Y_INT] = 0.0
         # ---- controller ------------------------------------------------------------
         if strategy == OPEN_LOOP:
             while vi < nvolt and volt_ticks[vi] <= t:
@@ -212,6 +216,10 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
             u = pid_output(e, -y[Y_OMEGA], y[Y_INT], p[P_K_P], p[P_K_V], p[P_K_I])
             duty_u, duty_l, heat_u, heat_l = actuator_commands(u, en_u, en_l, theta_F,
                                                                y[Y_THETA], keep_on)
+            # conditional integration: freeze the integral while saturated the same way
+            d[D_INTON] = 1.0
+            if p[P_anti_windup] != 0.0 and ((u >= 100.0 and e > 0.0) or (u <= -100.0 and e < 0.0)):
+                d[D_INTON] = 0.0
         if p[P_damping_enabled] != 0.0:
             damp_heat = en_u or en_l
         else:
@@ -223,7 +231,10 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
 
         # ---- interval [t, t_next] -----------------------------------------------
         ps = (t // pwm_ticks) * pwm_ticks
-        t_next = min(((t // dt_ticks) + 1) * dt_ticks, ps + pwm_ticks, t_end_ticks)
+        t_next = min(((t // dt_ticks) + 1) * dt_ticks, t_end_ticks)
+        if (0.0 < duty_u < 100.0) or (0.0 < duty_l < 100.0):
+            # a duty strictly inside (0, 100) %: split at every PWM period start
+            t_next = min(t_next, ps + pwm_ticks)
         if next_out <= t_end_ticks and next_out > t:
             t_next = min(t_next, next_out)
         if update_ticks > 0:
@@ -234,8 +245,9 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
             t_next = min(t_next, volt_ticks[vi])
         on_u = duty_u / 100.0 * pwm_ticks
         on_l = duty_l / 100.0 * pwm_ticks
-        e1 = ps + on_u
-        e2 = ps + on_l
+        # duty edges exist only for a duty strictly inside (0, 100) %
+        e1 = ps + on_u if 0.0 < duty_u < 100.0 else -1.0
+        e2 = ps + on_l if 0.0 < duty_l < 100.0 else -1.0
         if e1 > e2:
             e1, e2 = e2, e1
         bounds = np.empty(3)
@@ -253,16 +265,16 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
         for j in range(nb):
             b = bounds[j]
             mid = 0.5 * (a + b) - ps
-            Vu = level_u if (duty_u > 0.0 and mid < on_u) else V_L
-            Vl = level_l if (duty_l > 0.0 and mid < on_l) else V_L
+            Vu = level_u if (duty_u >= 100.0 or (duty_u > 0.0 and mid < on_u)) else V_L
+            Vl = level_l if (duty_l >= 100.0 or (duty_l > 0.0 and mid < on_l)) else V_L
             d[D_VU] = Vu
             d[D_VL] = Vl
-            if Vu > V_L and Vl > V_L:
+            if Vu > V_L and Vl > V_L and b > a:
                 counters[C_VIOLATIONS] += 1
             dTu = wire_temperature_rate(y[Y_TU], Vu, heat_u, p)
             dTl = wire_temperature_rate(y[Y_TL], Vl, heat_l, p)
-            _update_branch(d, D_BRU, D_STU, D_XHU, dTu, xi_u, y[Y_TU], sig_u, p)
-            _update_branch(d, D_BRL, D_STL, D_XHL, dTl, xi_l, y[Y_TL], sig_l, p)
+            _update_branch(d, D_BRU, D_STU, D_XHU, dTu, xi_u, y[Y_TU], sig_u, p, turn, 0)
+            _update_branch(d, D_BRL, D_STL, D_XHL, dTl, xi_l, y[Y_TL], sig_l, p, turn, 1)
             d[D_STUCK] = 1.0 if stuck else 0.0
             k1 = work[0]
             evaluate(y, d, p, k1, aux)

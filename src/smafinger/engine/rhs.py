@@ -35,7 +35,7 @@ Y_THETA, Y_OMEGA, Y_TU, Y_TL, Y_SU, Y_SL, Y_INT, Y_EU, Y_EL = range(N_STATE)
 
 N_DISC = 14
 (D_VU, D_VL, D_BRU, D_STU, D_XHU, D_BRL, D_STL, D_XHL, D_HEATU, D_HEATL, D_STUCK, D_CDF,
- D_THF, D_SPARE) = range(N_DISC)
+ D_THF, D_INTON) = range(N_DISC)
 
 N_AUX = 13
 (A_ME, A_XIU, A_XIL, A_SU, A_SL, A_DTU, A_DTL, A_XU, A_XL, A_BU, A_BL, A_PU, A_PL) = range(N_AUX)
@@ -135,7 +135,7 @@ def evaluate(y, d, p, dy, aux):
     dy[Y_TL] = dTl
     dy[Y_SU] = dsu
     dy[Y_SL] = dsl
-    dy[Y_INT] = d[D_THF] - theta
+    dy[Y_INT] = (d[D_THF] - theta) * d[D_INTON]
     R = p[P_R_w] * p[P_L_w]  # whole-wire resistance for the electrical energy
     dy[Y_EU] = Vu * Vu / R
     dy[Y_EL] = Vl * Vl / R

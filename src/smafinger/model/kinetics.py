@@ -102,6 +102,37 @@ def branch_start(branch, xi, T, sigma, A_S0, A_F0, c_A, M_S0, M_F0, c_M):
 
 
 @njit(cache=True)
+def next_branch(branch, dT_dt, T, turn, reversal):
+    """Branch for the next step and the updated turning temperature.
+
+    ``reversal`` = 0: the sign of dT/dt decides (MODEL-NOTES, authors' model).
+    ``reversal`` > 0: the branch changes only once T has moved back by ``reversal`` from its
+    extreme since the last change (``turn``), so that PWM ripple does not open minor loops.
+    """
+    if reversal <= 0.0:
+        return branch_of(dT_dt), T
+    nb = branch
+    if branch == HEATING:
+        if T > turn:
+            turn = T
+        elif T < turn - reversal:
+            nb = COOLING
+    elif branch == COOLING:
+        if T < turn:
+            turn = T
+        elif T > turn + reversal:
+            nb = HEATING
+    else:
+        if T > turn + reversal:
+            nb = HEATING
+        elif T < turn - reversal:
+            nb = COOLING
+    if nb != branch:
+        turn = T
+    return nb, turn
+
+
+@njit(cache=True)
 def branch_of(dT_dt):
     """Branch from the sign of dT/dt (MODEL-NOTES)."""
     if dT_dt > 0.0:

@@ -19,8 +19,8 @@ _NAMES = """
 S_w L_w M_w C_p R_w A_w A_S0 A_F0 c_A M_S0 M_F0 c_M D_A D_M eps_R T_amb T_init xi_init
 h0_h h2_h h0_c h2_c I m g d_CM M_SF M_DF C_DF_h C_DF_c omega_stick theta0
 r a0_u a0_l a1 a2 a4 a5 K_S xlim_u xlim_l fact V_H V_L t_P K_P K_V K_I
-keep_on_cooling integral_never stress_algebraic stick_initial_only damping_enabled
-path0_u path0_l sigma0_u sigma0_l eps_tot0_u eps_tot0_l x0_u x0_l
+keep_on_cooling integral_never anti_windup stress_algebraic stick_initial_only damping_enabled
+reversal path0_u path0_l sigma0_u sigma0_l eps_tot0_u eps_tot0_l x0_u x0_l
 """.split()
 
 #: index of each packed value, e.g. ``IDX["S_w"]``
@@ -82,6 +82,7 @@ def pack(p: ParameterSet) -> np.ndarray:
     put("T_amb", p.T_amb_C)
     put("T_init", p.T_init_C)
     put("xi_init", p.xi_init)
+    put("reversal", p.minor_loop_reversal_C)
     put("h0_h", p.h0_heating_W_m2K)
     put("h2_h", p.h2_heating_W_m2K3)
     put("h0_c", p.h0_cooling_W_m2K)
@@ -118,6 +119,7 @@ def pack(p: ParameterSet) -> np.ndarray:
     put("K_I", p.K_I_per_rad_s)
     put("keep_on_cooling", float(p.controller_in_cooling))
     put("integral_never", float(p.integral_reset == "never"))
+    put("anti_windup", float(p.anti_windup == "clamp"))
     put("stress_algebraic", float(p.stress_law == "algebraic"))
     put("stick_initial_only", float(p.friction_sticking == "initial-only"))
     put("damping_enabled", float(p.damping_switch == "enabled"))

@@ -36,5 +36,6 @@ def parameters() -> ParameterSet:
         stress_law="algebraic",
         friction_sticking="initial-only",
         damping_switch="enabled",
+        minor_loop_reversal_C=0.0,
         **{k: v for k, v in GEOMETRY.items()},
     )

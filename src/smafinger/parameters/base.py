@@ -62,6 +62,11 @@ class ParameterSet:
     D_M_Pa: float = _num(1e8, 1e12, "martensite Young's modulus D_M")
     eps_R: float = _num(1e-6, 0.2, "maximum recoverable strain eps_R")
     xi_init: float = _num(0.0, 1.0, "initial martensite fraction of both wires")
+    minor_loop_reversal_C: float = _num(
+        0.0, 50.0,
+        "temperature reversal needed to switch kinetics branch (0: sign of dT/dt, authors' model; "
+        ">0 keeps PWM ripple from ratcheting xi through minor loops)",
+    )
 
     # --- heat transfer (Eq. 11) -----------------------------------------------------------
     T_amb_C: float = _num(-50.0, 200.0, "ambient temperature")
@@ -115,7 +120,15 @@ class ParameterSet:
     controller_in_cooling: bool = _flag(
         "keep the PID on in an actuator's cooling phase (False: 0 V while cooling, Fig. 11)"
     )
-    integral_reset: str = _choice(("segment", "never"), "reset the error integral at each new target, or never"
+    integral_reset: str = _choice(
+        ("segment", "never"),
+        "'segment': reset the error integral at each new target and when an actuator is "
+        "newly enabled; 'never': integrate from t = 0 (authors' 2020 model)",
+    )
+    anti_windup: str = _choice(
+        ("none", "clamp"),
+        "'clamp': stop integrating while the duty is saturated and the error would push it "
+        "further (conditional integration); 'none': plain PID as in the paper",
     )
 
     # --- model options ---------------------------------------------------------------------

@@ -13,7 +13,10 @@ The joint geometry is the authors' (see :mod:`.geometry`).
 Choices of ours where the paper is silent (named options of the model):
 ``spring_init = "equilibrium"`` (upper spring solved from the moment balance, MODEL-NOTES),
 ``friction_sticking = "restick"``, ``damping_switch = "heating-phase"``,
-``integral_reset = "segment"``, ``controller_in_cooling = True`` (Fig. 11 case i).
+``integral_reset = "segment"``, ``controller_in_cooling = True`` (Fig. 11 case i),
+``minor_loop_reversal_C = 0.5`` (a kinetics branch switches after a 0.5 degC reversal, so
+that the 1 kHz PWM ripple does not ratchet xi through minor loops; 0 is the literal
+sign-of-dT/dt rule of the authors' model).
 
 :func:`table2` gives the set with Table II's own h0 = 70, h2 = 0.001, C_DF = 0.02 for both
 phases, as used in the parametric analysis of Sec. 3.1 (Figs. 7-8).
@@ -44,6 +47,7 @@ def parameters() -> ParameterSet:
         D_M_Pa=28e9,
         eps_R=0.023,
         xi_init=1.0,
+        minor_loop_reversal_C=0.5,
         T_amb_C=23.0,
         T_init_C=23.0,
         h0_heating_W_m2K=20.0,
@@ -72,6 +76,7 @@ def parameters() -> ParameterSet:
         controller_update_s=0.01,
         controller_in_cooling=True,
         integral_reset="segment",
+        anti_windup="none",
         stress_law="rate",
         friction_sticking="restick",
         damping_switch="heating-phase",

@@ -1,0 +1,259 @@
+"""Loading and validating bench data for identification.
+
+Two kinds of file:
+
+- **Strain-temperature curves** (material test under constant load), as in the
+  ``sma-thermal-cycling`` data set: whitespace-separated, no header (one all-text header line
+  is tolerated), ``#`` comments and blank lines ignored, three columns: temperature [degC],
+  strain [-] (a fraction, not percent), stress [MPa]. Rows in time order: the heating half first
+  (up to the row of maximum temperature), then the cooling half.
+- **Angle-vs-time curves** of the joint (the paper's Fig. 9): CSV with a header naming the
+  columns time [s] and angle [deg], and optionally voltage [V] (the upper wire's drive).
+  Recognised names (case-insensitive, units in brackets or after ``_`` ignored): ``time``/``t``,
+  ``angle``/``theta``, ``voltage``/``v``/``v_upper``.
+
+Any problem raises :class:`DataError` with one line naming the file, the row and the problem.
+"Row N" counts data rows from 1; the file's line number is given too.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+#: sensible ranges (inclusive); values outside are refused as bad data
+TEMPERATURE_RANGE_C = (-100.0, 300.0)
+STRESS_RANGE_MPA = (0.0, 1500.0)
+STRAIN_RANGE = (-0.05, 0.2)
+ANGLE_RANGE_DEG = (-180.0, 180.0)
+VOLTAGE_RANGE_V = (0.0, 100.0)
+MAX_TIME_S = 600.0
+
+#: fewest rows accepted
+MIN_ROWS_KINETICS = 20
+MIN_ROWS_HALF = 5
+MIN_ROWS_JOINT = 10
+
+
+class DataError(ValueError):
+    """Bench data is unusable; the message is one line naming the file, the row and the problem."""
+
+
+def _where(path, row: int | None = None, line: int | None = None) -> str:
+    if row is None:
+        return f"{path}" if line is None else f"{path}: line {line}"
+    return f"{path}: row {row} (line {line})"
+
+
+def _read_lines(path: Path) -> list[str]:
+    try:
+        return path.read_text(encoding="utf-8", errors="replace").splitlines()
+    except FileNotFoundError:
+        raise DataError(f"{path}: file not found") from None
+    except IsADirectoryError:
+        raise DataError(f"{path}: is a directory, not a data file") from None
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _number(path, row, line, column: str, text: str) -> float:
+    text = text.strip()
+    if text == "":
+        raise DataError(f"{_where(path, row, line)}: {column} is missing (empty field)")
+    try:
+        v = float(text)
+    except ValueError:
+        raise DataError(f"{_where(path, row, line)}: {column} {text!r} is not a number") from None
+    if math.isnan(v):
+        raise DataError(f"{_where(path, row, line)}: {column} is NaN")
+    if math.isinf(v):
+        raise DataError(f"{_where(path, row, line)}: {column} is infinite")
+    return v
+
+
+def _check_range(path, row, line, column: str, v: float, rng: tuple[float, float], unit: str,
+                 hint: str = "") -> None:
+    lo, hi = rng
+    if not lo <= v <= hi:
+        raise DataError(f"{_where(path, row, line)}: {column} {v:g}{unit} is outside the sensible "
+                        f"range [{lo:g}, {hi:g}]{unit}{hint}")
+
+
+# ---------------------------------------------------------------------------------------
+# strain-temperature curves
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class StrainCurve:
+    """One constant-load thermal cycle: heating half ``[0, split]``, cooling half ``[split, n)``."""
+
+    path: str
+    T_C: np.ndarray
+    strain: np.ndarray
+    stress_Pa: np.ndarray
+    split: int  # row index of the maximum temperature (last row of the heating half)
+
+    @property
+    def name(self) -> str:
+        return Path(self.path).name
+
+    @property
+    def n(self) -> int:
+        return len(self.T_C)
+
+    @property
+    def stress_MPa_mean(self) -> float:
+        return float(np.mean(self.stress_Pa) / 1e6)
+
+
+KINETICS_COLUMNS = ("temperature", "strain", "stress")
+
+
+def load_strain_curve(path: str | Path) -> StrainCurve:
+    """Read and validate a strain-temperature file (see the module docstring)."""
+    path = Path(path)
+    rows: list[tuple[int, list[str]]] = []  # (line number, fields)
+    for ln, text in enumerate(_read_lines(path), start=1):
+        s = text.strip()
+        if not s or s.startswith("#"):
+            continue
+        rows.append((ln, s.split()))
+    # tolerate one all-text header line
+    if rows and not any(_is_number(f) for f in rows[0][1]):
+        rows = rows[1:]
+    if not rows:
+        raise DataError(f"{path}: no data rows (expected columns: temperature [degC], strain [-], stress [MPa])")
+    T = np.empty(len(rows))
+    e = np.empty(len(rows))
+    s = np.empty(len(rows))
+    for i, (ln, fields) in enumerate(rows):
+        row = i + 1
+        if len(fields) < 3:
+            missing = ", ".join(KINETICS_COLUMNS[len(fields):])
+            raise DataError(f"{_where(path, row, ln)}: {len(fields)} column(s), missing {missing} "
+                            f"(expected 3: temperature [degC], strain [-], stress [MPa])")
+        if len(fields) > 3:
+            raise DataError(f"{_where(path, row, ln)}: {len(fields)} columns, expected 3 "
+                            f"(temperature [degC], strain [-], stress [MPa])")
+        T[i] = _number(path, row, ln, "temperature", fields[0])
+        e[i] = _number(path, row, ln, "strain", fields[1])
+        s[i] = _number(path, row, ln, "stress", fields[2])
+        _check_range(path, row, ln, "temperature", T[i], TEMPERATURE_RANGE_C, " degC")
+        _check_range(path, row, ln, "strain", e[i], STRAIN_RANGE, "",
+                     " (give strain as a fraction, not in percent)" if e[i] > STRAIN_RANGE[1] else "")
+        _check_range(path, row, ln, "stress", s[i], STRESS_RANGE_MPA, " MPa",
+                     " (give stress in MPa)" if s[i] > STRESS_RANGE_MPA[1] else "")
+    n = len(rows)
+    if n < MIN_ROWS_KINETICS:
+        raise DataError(f"{_where(path, n, rows[-1][0])}: too few points: the file ends after {n} "
+                        f"data rows, at least {MIN_ROWS_KINETICS} are needed")
+    split = int(np.argmax(T))
+    if split + 1 < MIN_ROWS_HALF or n - split < MIN_ROWS_HALF:
+        half = "heating" if split + 1 < MIN_ROWS_HALF else "cooling"
+        raise DataError(
+            f"{_where(path, split + 1, rows[split][0])}: the maximum temperature ({T[split]:g} degC) "
+            f"leaves too few points for the {half} half (rows must heat first, then cool; at "
+            f"least {MIN_ROWS_HALF} rows each)")
+    return StrainCurve(str(path), T, e, s * 1e6, split)
+
+
+# ---------------------------------------------------------------------------------------
+# angle-vs-time curves
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AngleCurve:
+    """A measured joint angle against time (t = 0: the upper wire is switched on)."""
+
+    path: str
+    t_s: np.ndarray
+    angle_deg: np.ndarray
+    voltage_V: np.ndarray | None = None
+
+    @property
+    def name(self) -> str:
+        return Path(self.path).name
+
+
+_ALIASES = {
+    "time": ("time", "t"),
+    "angle": ("angle", "theta", "phi"),
+    "voltage": ("voltage", "v", "v_upper", "voltage_upper", "u"),
+}
+_UNIT_SUFFIX = re.compile(r"(\[.*\]|\(.*\)|_(s|sec|deg|degrees|v|volt|volts|rad)$)")
+
+
+def _canonical(name: str) -> str | None:
+    key = name.strip().lower()
+    key = _UNIT_SUFFIX.sub("", key).strip().strip("_").strip()
+    key = key.replace(" ", "_")
+    for canon, names in _ALIASES.items():
+        if key in names:
+            return canon
+    return None
+
+
+def load_angle_curve(path: str | Path) -> AngleCurve:
+    """Read and validate an angle-vs-time CSV (see the module docstring)."""
+    path = Path(path)
+    lines = _read_lines(path)
+    numbered = [(ln, t) for ln, t in enumerate(lines, start=1) if t.strip() and not t.lstrip().startswith("#")]
+    if not numbered:
+        raise DataError(f"{path}: empty file (expected a CSV header with columns time [s], angle [deg])")
+    head_ln, head_text = numbered[0]
+    header = next(csv.reader([head_text]))
+    cols: dict[str, int] = {}
+    for j, name in enumerate(header):
+        c = _canonical(name)
+        if c is not None and c not in cols:
+            cols[c] = j
+    found = ", ".join(repr(h.strip()) for h in header)
+    for need, unit in (("time", "s"), ("angle", "deg")):
+        if need not in cols:
+            hint = " (the first line must be a header)" if all(_is_number(h) for h in header) else ""
+            raise DataError(f"{_where(path, line=head_ln)}: no {need} column [{unit}] in the header "
+                            f"(found: {found}){hint}")
+    data = numbered[1:]
+    n = len(data)
+    t = np.empty(n)
+    a = np.empty(n)
+    has_v = "voltage" in cols
+    v = np.empty(n) if has_v else None
+    for i, (ln, text) in enumerate(data):
+        row = i + 1
+        fields = next(csv.reader([text]))
+        for c, arr, unit, rng in (("time", t, "s", None), ("angle", a, " deg", ANGLE_RANGE_DEG),
+                                  ("voltage", v, " V", VOLTAGE_RANGE_V)):
+            if arr is None:
+                continue
+            j = cols[c]
+            if j >= len(fields):
+                raise DataError(f"{_where(path, row, ln)}: {c} column missing ({len(fields)} field(s), "
+                                f"header has {len(header)})")
+            arr[i] = _number(path, row, ln, c, fields[j])
+            if rng is not None:
+                _check_range(path, row, ln, c, arr[i], rng, unit)
+        if t[i] < 0:
+            raise DataError(f"{_where(path, row, ln)}: time {t[i]:g} s is negative "
+                            f"(t = 0 is when the wire is switched on)")
+        if t[i] > MAX_TIME_S:
+            raise DataError(f"{_where(path, row, ln)}: time {t[i]:g} s is beyond {MAX_TIME_S:g} s "
+                            f"(give the time in seconds)")
+        if i > 0 and not t[i] > t[i - 1]:
+            raise DataError(f"{_where(path, row, ln)}: time {t[i]:g} s is not after the previous "
+                            f"row's {t[i - 1]:g} s (time must increase)")
+    if n < MIN_ROWS_JOINT:
+        where = _where(path, n, data[-1][0]) if n else _where(path, line=head_ln)
+        raise DataError(f"{where}: too few points: {n} data rows, at least {MIN_ROWS_JOINT} are needed")
+    return AngleCurve(str(path), t, a, v)

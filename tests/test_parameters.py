@@ -1,0 +1,92 @@
+"""Parameter sets: validation messages, TOML round trip, overrides."""
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from smafinger.parameters import ParameterError, get, load_toml, resolve
+from smafinger.parameters.base import ParameterSet
+
+
+def test_named_sets_cite_their_source():
+    for name in ("paper2010", "authors2020", "paper2010-table2"):
+        p = get(name)
+        assert p.name == name and "20" in p.source
+
+
+def test_paper_values():
+    p = get("paper2010")
+    assert (p.h0_heating_W_m2K, p.h0_cooling_W_m2K, p.C_DF_heating_Nms, p.C_DF_cooling_Nms) == (20, 41, 0.03, 0.09)
+    assert (p.K_P_per_rad, p.K_V_s_per_rad, p.K_I_per_rad_s, p.controller_update_s) == (3000, 3000, 50, 0.01)
+    a = get("authors2020")
+    assert (a.resistance_ohm_per_m, a.M_SF_Nm, a.T_amb_C, a.T_init_C) == (8.66, 0.011, 60, 60)
+    assert (a.K_P_per_rad, a.K_V_s_per_rad, a.K_I_per_rad_s, a.controller_update_s) == (8000, 5000, 30, 0)
+
+
+@given(st.floats(allow_nan=True, allow_infinity=True))
+def test_out_of_range_value_refused_with_field_value_and_range(v):
+    lo, hi = 0.0, 1e4
+    if math.isfinite(v) and lo <= v <= hi:
+        assert get("paper2010").replace(h0_heating_W_m2K=v).h0_heating_W_m2K == v
+        return
+    with pytest.raises(ParameterError) as exc:
+        get("paper2010").replace(h0_heating_W_m2K=v)
+    msg = str(exc.value)
+    assert "h0_heating_W_m2K" in msg and "[0, 10000]" in msg
+
+
+def test_cross_checks():
+    with pytest.raises(ParameterError, match="A_S0_C"):
+        get("paper2010").replace(A_S0_C=120.0)
+    with pytest.raises(ParameterError, match="spring_length_upper_m"):
+        get("paper2010").replace(spring_length_upper_m=5e-3)
+    with pytest.raises(ParameterError, match="stress_law"):
+        get("paper2010").replace(stress_law="magic")
+
+
+def test_frozen():
+    p = get("paper2010")
+    with pytest.raises(Exception):
+        p.h0_heating_W_m2K = 3.0  # type: ignore[misc]
+
+
+def test_no_defaults():
+    with pytest.raises(TypeError):
+        ParameterSet()  # type: ignore[call-arg]
+
+
+def test_overrides():
+    p = get("paper2010").with_overrides(["h0_heating_W_m2K=25", "controller_in_cooling=false", "stress_law=algebraic"])
+    assert p.h0_heating_W_m2K == 25.0 and p.controller_in_cooling is False and p.stress_law == "algebraic"
+    with pytest.raises(ParameterError, match="NAME=VALUE"):
+        get("paper2010").with_overrides(["h0"])
+    with pytest.raises(ParameterError, match="unknown parameter"):
+        get("paper2010").with_overrides(["nope=1"])
+    with pytest.raises(ParameterError, match="not a number"):
+        get("paper2010").with_overrides(["h0_heating_W_m2K=abc"])
+
+
+def test_toml_round_trip(tmp_path):
+    for name in ("paper2010", "authors2020"):
+        p = get(name)
+        f = tmp_path / f"{name}.toml"
+        p.save(f)
+        assert load_toml(f, get) == p
+        assert resolve(str(f)) == p
+
+
+def test_toml_with_base_and_errors(tmp_path):
+    f = tmp_path / "fit.toml"
+    f.write_text('base = "paper2010"\nh0_heating_W_m2K = 33.0\n')
+    assert resolve(str(f)).h0_heating_W_m2K == 33.0
+    f.write_text('base = "paper2010"\nh0_heating_W_m2K = -1.0\n')
+    with pytest.raises(ParameterError, match="h0_heating_W_m2K"):
+        resolve(str(f))
+    f.write_text('h0_heating_W_m2K = 1.0\n')
+    with pytest.raises(ParameterError, match="missing parameter"):
+        resolve(str(f))
+    f.write_text('base = "paper2010"\nfoo = 1.0\n')
+    with pytest.raises(ParameterError, match="unknown parameter"):
+        resolve(str(f))
