@@ -88,7 +88,7 @@ def test_interlock_counter_counts_a_forced_violation():
     args["volt_l"] = np.array([8.0])  # bypasses the program validation on purpose
     out = np.full((args["t_end_ticks"] // args["out_ticks"] + 1, N_OUT), np.nan)
     counters = np.zeros(N_COUNTERS + 1, dtype=np.int64)
-    run_kernel(out=out, seg_actual=np.zeros(1, dtype=np.int64), counters=counters,
+    run_kernel(out=out, seg_actual=np.zeros(1, dtype=np.int64), seg_reached=np.zeros(1, dtype=np.int64), counters=counters,
                err_state=np.zeros(1 + N_STATE), **args)
     assert counters[C_VIOLATIONS] == 100
 
@@ -100,3 +100,21 @@ def test_interlock_never_violated_in_closed_loop(strategy):
         assert r.interlock_violations == 0
         both = (r.V_upper_V > 0) & (r.V_lower_V > 0)
         assert not both.any()
+
+
+@pytest.mark.parametrize("dt", [2e-3, 5e-4])
+def test_output_grid_independent_of_step(dt):
+    r = simulate("paper2010", "cooperative", "0:-25", t_end_s=3, dt_s=dt, output_interval_s=1e-3)
+    assert not np.isnan(r.data).any() and len(r.t) == 3001
+
+
+def test_reached_metric_agrees_with_reach_trigger():
+    """A 'reach' segment starts hold_s after the previous target was entered for good."""
+    r = simulate("paper2010", "cooperative", "0:-25,reach:-55", t_end_s=20, hold_s=0.5)
+    s0, s1 = r.metrics["segments"]
+    assert s0["reached_s"] is not None
+    assert s1["start_s"] == pytest.approx(s0["reached_s"] + 0.5, abs=2e-3)
+    # the sampled-signal rule agrees within one output interval
+    from smafinger.results import time_to_reach
+    alt = time_to_reach(r.t, r.theta_deg, -25.0, 0.0, s1["start_s"] + 1e-3, 0.5, 0.5 - 1e-3)
+    assert alt == pytest.approx(s0["reached_s"], abs=2e-3)

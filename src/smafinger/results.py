@@ -61,6 +61,7 @@ class SimulationResult:
     spec: Any
     data: np.ndarray
     segment_start_s: np.ndarray
+    segment_reached_s: np.ndarray
     substeps: int
     interlock_violations: int
     wall_s: float
@@ -151,9 +152,11 @@ def segment_bounds(result: SimulationResult) -> list[tuple[int, float, float]]:
 
 
 def time_to_reach(t, theta_deg, target_deg, start, end, tol_deg, hold_s):
-    """First time (from ``start``) after which theta stays within tol for ``hold_s``.
+    """From samples: first time (from ``start``) after which theta stays within tol for ``hold_s``.
 
-    None if that never happens inside [start, end].
+    None if that never happens inside [start, end]. (The metrics use the engine's own
+    record, made at every step boundary; this is the same rule on sampled signals, for
+    measured data.)
     """
     eps = 1e-9
     m = (t >= start - eps) & (t <= end + eps)
@@ -196,7 +199,7 @@ def compute_metrics(result: SimulationResult) -> dict:
             "end_s": end,
             "target_deg": seg.target_deg,
             "enable": seg.enable,
-            "reached_s": time_to_reach(t, th, seg.target_deg, start, end, spec.tol_deg, spec.hold_s),
+            "reached_s": None if math.isnan(result.segment_reached_s[i]) else float(result.segment_reached_s[i]),
             "overshoot_deg": over,
             "energy_J": {"upper": float(Eu[k1] - Eu[k0]), "lower": float(El[k1] - El[k0])},
             "peak_temperature_C": {"upper": float(np.max(Tu[m])), "lower": float(np.max(Tl[m]))},

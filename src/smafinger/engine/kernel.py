@@ -93,10 +93,11 @@ def _update_branch(d, i_br, i_st, i_xh, dT, xi_now, T, sigma, p, turn, side):
 def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
                volt_ticks, volt_u, volt_l, method, dt_ticks, tick_s, t_end_ticks,
                out_ticks, update_ticks, pwm_ticks, tol_rad, hold_ticks,
-               out, seg_actual, counters, err_state):
+               out, seg_actual, seg_reached, counters, err_state):
     """Simulate from t = 0 to t_end; fill ``out`` (one row per output sample).
 
-    Returns nothing; ``counters[C_STATUS]`` is STATUS_BLOWUP (with time and state in
+    ``seg_reached[k]`` is the tick at which segment k's target was entered for good (within
+    ``tol_rad`` for ``hold_ticks``), -1 if never. Returns nothing; ``counters[C_STATUS]`` is STATUS_BLOWUP (with time and state in
     ``err_state``) if the state became NaN or Inf.
     """
     y = np.zeros(N_STATE)
@@ -235,8 +236,7 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
         if (0.0 < duty_u < 100.0) or (0.0 < duty_l < 100.0):
             # a duty strictly inside (0, 100) %: split at every PWM period start
             t_next = min(t_next, ps + pwm_ticks)
-        if next_out <= t_end_ticks and next_out > t:
-            t_next = min(t_next, next_out)
+        t_next = min(t_next, ((t // out_ticks) + 1) * out_ticks)
         if update_ticks > 0:
             t_next = min(t_next, ((t // update_ticks) + 1) * update_ticks)
         if next_seg < nseg and seg_start[next_seg] > t:
@@ -360,8 +360,10 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
         if abs(y[Y_THETA] - theta_F) <= tol_rad:
             if band_since < 0:
                 band_since = t
-            if t - band_since >= hold_ticks:
+            if t - band_since >= hold_ticks and not confirmed:
                 confirmed = True
+                if next_seg >= 1:
+                    seg_reached[next_seg - 1] = band_since
         else:
             band_since = -1
         if t >= t_end_ticks:

@@ -125,9 +125,10 @@ def run_spec(spec: RunSpec, progress: bool = False):
     n_out = args["t_end_ticks"] // args["out_ticks"] + 1
     out = np.full((n_out, N_OUT), np.nan)
     seg_actual = np.full(len(spec.profile.segments), -1, dtype=np.int64)
+    seg_reached = np.full(len(spec.profile.segments), -1, dtype=np.int64)
     counters = np.zeros(N_COUNTERS + 1, dtype=np.int64)
     err = np.zeros(1 + N_STATE)
-    call = lambda: run_kernel(out=out, seg_actual=seg_actual, counters=counters, err_state=err, **args)  # noqa: E731
+    call = lambda: run_kernel(out=out, seg_actual=seg_actual, seg_reached=seg_reached, counters=counters, err_state=err, **args)  # noqa: E731
     t0 = time.perf_counter()
     if progress:
         _run_with_progress(call, out, spec.t_end_s)
@@ -138,7 +139,8 @@ def run_spec(spec: RunSpec, progress: bool = False):
         state = ", ".join(f"{n}={v:.6g}" for n, v in zip(STATE_NAMES, err[1:]))
         raise SimulationError(f"numerical blow-up at t = {err[0]:.9g} s: {state}")
     return SimulationResult(
-        spec=spec, data=out, segment_start_s=seg_actual * TICK_S, substeps=int(counters[C_SUBSTEPS]),
+        spec=spec, data=out, segment_start_s=seg_actual * TICK_S,
+        segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan), substeps=int(counters[C_SUBSTEPS]),
         interlock_violations=int(counters[C_VIOLATIONS]), wall_s=wall,
     )
 
