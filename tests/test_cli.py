@@ -61,3 +61,24 @@ def test_usage_errors_exit_2_with_one_line(args, needle, tmp_path):
     assert len(lines) == 1 and needle in lines[0], proc.stderr
     assert not out.exists() and not (tmp_path / "never.json").exists()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_atomic_write_keeps_umask_permissions_and_leaves_nothing_on_failure(tmp_path):
+    import os
+
+    from smafinger.results import atomic_write
+
+    old = os.umask(0o022)
+    try:
+        atomic_write(tmp_path / "a.txt", lambda tmp: open(tmp, "w").write("x"))
+    finally:
+        os.umask(old)
+    assert (tmp_path / "a.txt").stat().st_mode & 0o777 == 0o644
+
+    def boom(tmp):
+        open(tmp, "w").write("half")
+        raise RuntimeError("disk full")
+
+    with pytest.raises(RuntimeError):
+        atomic_write(tmp_path / "b.txt", boom)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.txt"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
+import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,17 +40,25 @@ EXPORT_COLUMNS: dict[str, tuple[str, float]] = {
 _COL = {n: i for i, n in enumerate(OUT_COLUMNS)}
 
 
-def atomic_write(path: str | Path, write) -> None:
-    """Write via a temporary file in the same directory, then rename: never half-written."""
+def temp_path(path: str | Path) -> Path:
+    """A fresh hidden temporary name beside ``path`` (for write-then-rename)."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent if str(path.parent) else ".", prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
+    return path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
+
+
+def atomic_write(path: str | Path, write) -> None:
+    """Write via a temporary file in the same directory, then rename: never half-written.
+
+    ``write(tmp)`` creates the temporary file itself, so the result gets the usual
+    permissions (umask), not the 0600 of :func:`tempfile.mkstemp`.
+    """
+    path = Path(path)
+    tmp = temp_path(path)
     try:
-        write(tmp)
+        write(str(tmp))
         os.replace(tmp, path)
     except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+        tmp.unlink(missing_ok=True)
         raise
 
 
