@@ -45,7 +45,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..engine.run import RunSpec, make_spec
+from ..engine.run import RunSpec, SimulationError, make_spec  # noqa: F401 (SimulationError: re-exported)
 from ..parameters import ParameterError, ParameterSet, resolve
 from ..parameters.base import field_spec
 from ..profiles import ProfileError
@@ -351,6 +351,12 @@ def parse_spec(data: dict, source: str = "<dict>", base_dir: Path = Path(".")) -
         elif k == "scenario":
             if not isinstance(v, str):
                 raise _err(source, "[base] scenario", f"{v!r} is not a string")
+            try:
+                _scenario_spec(v)
+            except SweepSpecError as exc:
+                raise SweepSpecError(f"{source}: {exc}") from None
+            except (ValueError, KeyError) as exc:
+                raise _err(source, "[base] scenario", f"{str(exc).strip(chr(39))}") from None
             b[k] = v
         else:
             b[k] = _coerce(source, f"[base] {k}", k, v)
@@ -430,7 +436,8 @@ def parse_spec(data: dict, source: str = "<dict>", base_dir: Path = Path(".")) -
             if log and lo <= 0:
                 raise _err(source, f"{where}.min", f"{lo!r} must be > 0 with log = true")
             for f in fields:
-                if f in RUN_KEYS and RUN_KEYS[f] is not float or f not in RUN_KEYS and field_spec(f).metadata["kind"] != "float":
+                numeric = RUN_KEYS[f] is float if f in RUN_KEYS else field_spec(f).metadata["kind"] == "float"
+                if not numeric:
                     raise _err(source, f"{where}.fields", f"{f!r} is not numeric and cannot be sampled in a range")
             varies.append(Vary(vname, tuple(fields), None, lo, hi, log))
             continue
@@ -600,6 +607,7 @@ def _write_part(pdir: Path, rows: list[dict], traces: list[tuple[str, dict]]) ->
 
     The rows file is the 'done' mark: it is written last.
     """
+    pdir.mkdir(exist_ok=True)
     stem = f"part-{time.time_ns():020d}-{uuid.uuid4().hex[:8]}"
     if traces:
         _atomic_parquet(_traces_table(traces), pdir / f"{stem}.traces.parquet")
@@ -662,9 +670,11 @@ def _load_done(out: Path, pdir: Path, traces: bool):
     rows = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["run_id", "_src"])
     trs = pd.concat(tframes, ignore_index=True) if tframes else pd.DataFrame(columns=["run_id", "_src"])
     if traces and len(rows):
-        # a run counts as done only if its trace is there too
+        # a run counts as done only if its trace is there too (a failed run has none)
         have = set(zip(trs["run_id"], trs["_src"]))
-        rows = rows[[(r, s) in have for r, s in zip(rows["run_id"], rows["_src"])]]
+        failed = (rows["status"] == "error").to_numpy() if "status" in rows.columns else np.zeros(len(rows), bool)
+        traced = np.array([(r, s) in have for r, s in zip(rows["run_id"], rows["_src"])], dtype=bool)
+        rows = rows[traced | failed]
     rows = rows.drop_duplicates("run_id", keep="last")
     return rows, trs
 
@@ -719,10 +729,9 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     reduce = partial(metrics_row, traces_interval_s=spec.traces_interval_s if traces else None)
     _say(console, f"sweep {spec.name}: {total} runs"
                   + (f", {len(done_ids)} already done" if done_ids else ""))
-    backend = "none"
+    backend = "nothing left to run"
     failed = 0
     if todo:
-        pdir.mkdir(exist_ok=True)
         pool = batch.make_pool(workers, scheduler)
         backend = (f"Dask scheduler {scheduler if isinstance(scheduler, str) else 'client'} "
                    f"({pool.slots} worker threads)" if scheduler is not None else

@@ -184,9 +184,12 @@ class LocalPool(SerialPool):
     """A pool of worker processes on this machine (kept alive until :meth:`close`)."""
 
     def __init__(self, workers: int | None = None):
-        self.slots = workers or available_cores()
+        self.slots = available_cores() if workers is None else workers
         if self.slots < 1:
             raise ValueError(f"workers = {workers!r} must be >= 1")
+        # compile here first if numba's disk cache is stale: the workers then load it
+        # instead of compiling all at once
+        warm_up()
         self._ex = ProcessPoolExecutor(max_workers=self.slots, mp_context=_mp_context(),
                                        initializer=_init_local_worker)
 
@@ -267,7 +270,7 @@ class DaskPool(SerialPool):
     by the cluster (its tasks are rescheduled on the others); results are only yielded once.
     """
 
-    def __init__(self, address, timeout_s: float = 20.0):
+    def __init__(self, address, timeout_s: float = 10.0):
         distributed = _import_distributed()
         self._distributed = distributed
         if isinstance(address, distributed.Client):
@@ -280,6 +283,7 @@ class DaskPool(SerialPool):
             except (OSError, TimeoutError) as exc:
                 raise BatchError(f"cannot connect to the Dask scheduler at {address}: {exc}") from None
             self._own = True
+        warm_up()  # refreshes numba's disk cache, which workers on this machine then load
         try:
             self.client.register_plugin(__getattr__("WarmUpPlugin")(), name="smafinger-warm-up")
             info = self.client.run(_worker_info)
@@ -301,7 +305,7 @@ class DaskPool(SerialPool):
 
     def map_chunks(self, chunks, reduce=None):
         futures = [self.client.submit(run_chunk, c, reduce, pure=False) for c in chunks]
-        ac = self._distributed.as_completed(futures)
+        ac = self._distributed.as_completed(futures, loop=self.client.loop)
         try:
             for f in ac:
                 try:

@@ -1,0 +1,337 @@
+"""Parametric sweeps: spec parsing, sampling, run ids, tables, resume, CLI."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from smafinger.analysis import sweep as sw
+from smafinger.analysis.sweep import SweepInterrupted, SweepSpecError, load_spec, parse_spec, run_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG8 = ROOT / "examples" / "sweep-fig8.toml"
+SRC = Path(sw.__file__).resolve().parents[2]
+
+
+def _spec(vary: str, sweep: str = "", base: str | None = None, t_end: float = 2.0) -> str:
+    base = base if base is not None else (
+        f'params = "paper2010-table2"\nstrategy = "open-loop"\nvoltage = "0:8:0,1:0:0"\nt_end_s = {t_end}\n')
+    return f"[base]\n{base}\n[sweep]\n{sweep}\n{vary}\n"
+
+
+def _write(tmp_path: Path, text: str, name: str = "spec.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+SMALL = _spec('[vary.h0]\nfields = ["h0_heating_W_m2K", "h0_cooling_W_m2K"]\nvalues = [60.0, 70.0]\n'
+              '[vary]\nC_DF_heating_Nms = [0.02, 0.03, 0.04]\n')
+
+
+def _frame(path: Path) -> pd.DataFrame:
+    return pd.read_parquet(path).drop(columns=["wall_s"])
+
+
+# ---- spec ----------------------------------------------------------------------------
+def test_fig8_example_spec():
+    spec = load_spec(FIG8)
+    runs = spec.runs()
+    assert len(runs) >= 200
+    assert len({r.run_id for r in runs}) == len(runs)
+    p = runs[0].spec.params
+    assert p.name == "paper2010-table2"
+    assert p.h0_heating_W_m2K == p.h0_cooling_W_m2K == 60.0  # tied names set both fields
+    assert p.h2_heating_W_m2K3 == p.h2_cooling_W_m2K3 == 5e-4
+    assert runs[-1].spec.params.h0_cooling_W_m2K == 70.0
+    assert p.friction_sticking == "initial-only"  # Sec. 3.1: stick-slip neglected
+    assert runs[0].spec.strategy == "open-loop" and runs[0].spec.t_end_s == 20.0
+    # stable across reloads
+    assert [r.run_id for r in load_spec(FIG8).runs()] == [r.run_id for r in runs]
+
+
+def test_grid_list_and_run_ids(tmp_path):
+    grid = load_spec(_write(tmp_path, SMALL))
+    pts = grid.points()
+    assert pts[:4] == [{"h0": 60.0, "C_DF_heating_Nms": 0.02}, {"h0": 60.0, "C_DF_heating_Nms": 0.03},
+                       {"h0": 60.0, "C_DF_heating_Nms": 0.04}, {"h0": 70.0, "C_DF_heating_Nms": 0.02}]
+    lst = load_spec(_write(tmp_path, SMALL.replace("[sweep]\n", '[sweep]\nmode = "list"\n')
+                           .replace("[0.02, 0.03, 0.04]", "[0.02, 0.03]"), "l.toml"))
+    assert lst.points() == [{"h0": 60.0, "C_DF_heating_Nms": 0.02}, {"h0": 70.0, "C_DF_heating_Nms": 0.03}]
+    ids = [r.run_id for r in grid.runs()]
+    assert len(set(ids)) == 6 and all(len(i) == 16 for i in ids)
+    # the same run in another spec has the same id
+    assert [r.run_id for r in lst.runs()] == [ids[0], ids[4]]
+    lin = parse_spec({"base": {"t_end_s": 1.0, "profile": "0:-30"},
+                      "vary": {"M_SF_Nm": {"start": 1e-3, "stop": 1e-1, "num": 3, "log": True}}})
+    assert np.allclose([p["M_SF_Nm"] for p in lin.points()], [1e-3, 1e-2, 1e-1])
+
+
+def test_random_and_lhs_sampling_seeded():
+    def spec(mode, seed, n=20):
+        return parse_spec({"base": {"strategy": "cooperative", "profile": "0:-30", "t_end_s": 1.0},
+                           "sweep": {"mode": mode, "samples": n, "seed": seed},
+                           "vary": {"h0": {"fields": ["h0_heating_W_m2K", "h0_cooling_W_m2K"], "min": 60, "max": 70},
+                                    "h2_heating_W_m2K3": {"min": 5e-4, "max": 1e-3, "log": True}}})
+    for mode in ("random", "lhs"):
+        a, b, c = spec(mode, 1).points(), spec(mode, 1).points(), spec(mode, 2).points()
+        assert a == b and a != c
+        h0 = np.array([p["h0"] for p in a])
+        h2 = np.array([p["h2_heating_W_m2K3"] for p in a])
+        assert np.all((60 <= h0) & (h0 <= 70)) and np.all((5e-4 <= h2) & (h2 <= 1e-3))
+    lhs = np.array([p["h0"] for p in spec("lhs", 3).points()])
+    # Latin hypercube: exactly one sample in each of the n equal strata
+    assert sorted(np.floor((lhs - 60) / 10 * 20).astype(int).tolist()) == list(range(20))
+    runs = spec("lhs", 3).runs()
+    assert runs[0].spec.params.h0_heating_W_m2K == runs[0].spec.params.h0_cooling_W_m2K == runs[0].values["h0"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[vary]\nh0_heating = [1.0]\n', "'h0_heating' is neither a parameter nor a run setting"),
+    ('[vary]\nh0_heating_W_m2K = [60.0, "x"]\n', r"\[vary\] h0_heating_W_m2K.values\[1\]: 'x' is not a number"),
+    ('[vary]\nh0_heating_W_m2K = [60.0, -5.0]\n', r"point 1 \(h0_heating_W_m2K = -5.0\): h0_heating_W_m2K = -5.0 is outside"),
+    ('[vary]\nh0_heating_W_m2K = {min = 1, max = 2}\n', "min/max ranges need mode = 'random' or 'lhs'"),
+    ('[vary]\nh0_heating_W_m2K = {start = 1, stop = 2}\n', "num is missing"),
+    ('[vary]\nh0_heating_W_m2K = [60.0, 60.0]\n', "points 0 and 1 are the same run"),
+    ('[vary]\nh0_heating_W_m2K = [60.0]\nh0 = {fields = ["h0_heating_W_m2K"], values = [1.0]}\n',
+     "'h0_heating_W_m2K' is already set by"),
+    ('[vary]\n', r"\[vary\]: is missing or empty"),
+    ('[vary]\nh0_heating_W_m2K = {values = [1.0], step = 2}\n', "unknown key.*step"),
+    ('[varry]\nx = 1\n[vary]\nh0_heating_W_m2K = [60.0]\n', "unknown table.*varry"),
+])
+def test_bad_specs_name_field_and_value(tmp_path, text, message):
+    p = _write(tmp_path, _spec(text))
+    with pytest.raises(SweepSpecError, match=message):
+        load_spec(p).runs()
+
+
+@pytest.mark.parametrize("sweep, vary, message", [
+    ('mode = "cube"', '[vary]\nx = [1]\n', r"\[sweep\] mode: 'cube' is not one of grid, list, random, lhs"),
+    ('mode = "lhs"', '[vary]\nh0_heating_W_m2K = {min = 1, max = 2}\n', r"\[sweep\] samples: is required"),
+    ('mode = "lhs"\nsamples = 4', '[vary]\nh0_heating_W_m2K = {min = 3, max = 2}\n', "min = 3.0 must be below max = 2.0"),
+    ('mode = "lhs"\nsamples = 4', '[vary]\nstress_law = {min = 1, max = 2}\n', "not numeric"),
+    ('mode = "random"\nsamples = 4', '[vary]\nh0_heating_W_m2K = [1.0, 2.0]\n', "samples within ranges"),
+    ('samples = 4', '[vary]\nh0_heating_W_m2K = [1.0]\n', r"\[sweep\] samples: is only used with mode"),
+    ('mode = "list"', '[vary]\nh0_heating_W_m2K = [1.0, 2.0]\nh2_heating_W_m2K3 = [1e-3]\n', "lengths differ"),
+    ('chunk_size = 0', '[vary]\nh0_heating_W_m2K = [1.0]\n', r"\[sweep\] chunk_size: 0 must be >= 1"),
+])
+def test_bad_sweep_tables(tmp_path, sweep, vary, message):
+    with pytest.raises(SweepSpecError, match=message):
+        load_spec(_write(tmp_path, _spec(vary, sweep))).runs()
+
+
+def test_bad_base_and_files(tmp_path):
+    with pytest.raises(SweepSpecError, match=r"\[base\] t_end_s: 'long' is not a number"):
+        load_spec(_write(tmp_path, _spec("[vary]\nh0_heating_W_m2K = [1.0]\n", base='t_end_s = "long"')))
+    with pytest.raises(SweepSpecError, match=r"\[base\]: unknown key\(s\) tend"):
+        load_spec(_write(tmp_path, _spec("[vary]\nh0_heating_W_m2K = [1.0]\n", base="tend = 1")))
+    with pytest.raises(SweepSpecError, match="unknown parameter set 'nope'"):
+        load_spec(_write(tmp_path, _spec("[vary]\nh0_heating_W_m2K = [1.0]\n", base='params = "nope"'))).runs()
+    with pytest.raises(SweepSpecError, match=r"point 0 .*strategy open-loop needs a voltage program"):
+        load_spec(_write(tmp_path, _spec("[vary]\nh0_heating_W_m2K = [1.0]\n", base='strategy = "open-loop"'))).runs()
+    with pytest.raises(SweepSpecError, match="not valid TOML"):
+        load_spec(_write(tmp_path, "[base\n"))
+    with pytest.raises(SweepSpecError, match="sweep spec not found"):
+        load_spec(tmp_path / "missing.toml")
+    # a parameter file relative to the spec's folder, and varied run settings
+    (tmp_path / "mine.toml").write_text('base = "paper2010"\nM_SF_Nm = 0.02\n')
+    spec = load_spec(_write(tmp_path, _spec('[vary]\nprofile = ["0:-25", "0:-55"]\n',
+                                            base='params = "mine.toml"\nt_end_s = 1.0')))
+    runs = spec.runs()
+    assert [r.spec.params.M_SF_Nm for r in runs] == [0.02, 0.02]
+    assert [r.spec.profile.segments[0].target_deg for r in runs] == [-25.0, -55.0]
+
+
+def test_scenario_base(tmp_path):
+    scenarios = pytest.importorskip("smafinger.scenarios")
+    name = next(n for n in scenarios.names() if n.startswith("fig8-h0-60-upper"))
+    spec = load_spec(_write(tmp_path, _spec('[vary]\nh0 = {fields = ["h0_heating_W_m2K", "h0_cooling_W_m2K"], '
+                                            'values = [61.0, 62.0]}\n', base=f'scenario = "{name}"\ndt_s = 0.002')))
+    runs = spec.runs()
+    ref = scenarios.get(name).spec()
+    assert [r.spec.params.h0_cooling_W_m2K for r in runs] == [61.0, 62.0]
+    assert runs[0].spec.dt_s == 0.002 and runs[0].spec.t_end_s == ref.t_end_s
+    assert runs[0].spec.voltage == ref.voltage and runs[0].spec.strategy == ref.strategy
+    with pytest.raises(SweepSpecError, match=r"\[base\] scenario.*no-such-scenario"):
+        load_spec(_write(tmp_path, _spec("[vary]\nh0_heating_W_m2K = [1.0]\n", base='scenario = "no-such-scenario"')))
+
+
+# ---- running -------------------------------------------------------------------------
+def test_sweep_table_and_rerun_is_idempotent(tmp_path):
+    spec = _write(tmp_path, SMALL)
+    out = tmp_path / "res.parquet"
+    rep = run_sweep(spec, out, workers=1)
+    assert (rep.total, rep.ran, rep.resumed, rep.failed) == (6, 6, 0, 0)
+    assert not sw.parts_dir(out).exists()
+    df = pd.read_parquet(out)
+    assert list(df.columns[:5]) == ["run_id", "point", "h0", "C_DF_heating_Nms", "status"]
+    for c in ("energy_upper_J", "peak_T_upper_C", "peak_stress_upper_Pa", "interlock_violations",
+              "seg0_reached_s", "seg0_overshoot_deg", "theta_max_deg", "motion_start_s"):
+        assert c in df.columns
+    assert df["point"].tolist() == list(range(6)) and df["run_id"].is_unique
+    assert (df["status"] == "ok").all() and (df["interlock_violations"] == 0).all()
+    assert df.loc[0, "run_id"] == load_spec(spec).runs()[0].run_id
+    # each row is the run made alone
+    one = load_spec(spec).runs()[4]
+    alone = sw.metrics_row(__import__("smafinger").engine.run.run_spec(one.spec))
+    row = df.iloc[4]
+    for k, v in alone.items():
+        if k not in ("wall_s", "error"):
+            assert row[k] == v or (np.isnan(v) and np.isnan(row[k])), k
+    first = _frame(out)
+    rep2 = run_sweep(spec, out, workers=1)
+    assert (rep2.ran, rep2.resumed) == (0, 6)
+    pd.testing.assert_frame_equal(_frame(out), first)
+
+
+def test_interrupted_sweep_resumes(tmp_path):
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nchunk_size = 2\n"))
+    out = tmp_path / "res.parquet"
+
+    def stop(done, total):
+        if done >= 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(SweepInterrupted, match="interrupted after 2 of 6 runs"):
+        run_sweep(spec, out, workers=1, on_progress=stop)
+    assert not out.exists()
+    assert len(list(sw.parts_dir(out).glob("part-*.parquet"))) == 1
+    rep = run_sweep(spec, out, workers=1)
+    assert (rep.resumed, rep.ran) == (2, 4)
+    ref = tmp_path / "ref.parquet"
+    run_sweep(spec, ref, workers=1)
+    pd.testing.assert_frame_equal(_frame(out), _frame(ref))
+
+
+def test_killed_sweep_resumes_every_run_once(tmp_path):
+    """SIGKILL a running `smafinger sweep` after some parts are written; rerun; every run once."""
+    vary = '[vary]\nh0 = {fields = ["h0_heating_W_m2K", "h0_cooling_W_m2K"], start = 60.0, stop = 70.0, num = 40}\n' \
+           'h2_heating_W_m2K3 = [5e-4, 1e-3]\n'
+    spec = _write(tmp_path, _spec(vary, "chunk_size = 2", t_end=10.0))
+    out = tmp_path / "res.parquet"
+    parts = sw.parts_dir(out)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli_sweep", str(spec), "--out", str(out),
+                             "--workers", "2"], env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and proc.poll() is None:
+            if len(list(parts.glob("part-*.parquet"))) >= 3:
+                break
+            time.sleep(0.005)
+        os.killpg(proc.pid, signal.SIGKILL)  # the sweep and its worker processes
+    finally:
+        proc.wait(timeout=30)
+    n_parts = len(list(parts.glob("part-*.parquet")))
+    assert not out.exists(), "the sweep finished before it could be killed"
+    assert 3 <= n_parts < 40
+    rep = run_sweep(spec, out, workers=2)
+    assert rep.total == 80 and rep.resumed >= 6 and rep.resumed + rep.ran == 80
+    df = pd.read_parquet(out)
+    assert len(df) == 80 and df["run_id"].is_unique and df["point"].tolist() == list(range(80))
+    assert set(df["run_id"]) == {r.run_id for r in load_spec(spec).runs()}
+    assert not parts.exists()
+
+
+def test_failed_runs_are_rows_and_count_as_done(tmp_path, monkeypatch):
+    real = sw.metrics_row
+
+    def flaky(result, traces_interval_s=None):
+        if result.spec.params.C_DF_heating_Nms == 0.03:
+            raise sw.SimulationError("numerical blow-up at t = 1 s (on purpose)")
+        return real(result, traces_interval_s)
+
+    monkeypatch.setattr(sw, "metrics_row", flaky)
+    spec = _write(tmp_path, SMALL)
+    out = tmp_path / "res.parquet"
+    rep = run_sweep(spec, out, workers=1, traces=True)
+    df = pd.read_parquet(out)
+    assert rep.failed == 2 and (df["status"] == "error").sum() == 2
+    bad = df[df["status"] == "error"]
+    assert (bad["C_DF_heating_Nms"] == 0.03).all() and bad["energy_upper_J"].isna().all()
+    assert bad["error"].str.contains("SimulationError: numerical blow-up").all()
+    assert set(pd.read_parquet(rep.traces_out)["run_id"]) == set(df.loc[df["status"] == "ok", "run_id"])
+    rep2 = run_sweep(spec, out, workers=1, traces=True)  # deterministic failures are not redone
+    assert (rep2.ran, rep2.resumed) == (0, 6)
+
+
+def test_traces_option(tmp_path):
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\ntraces_interval_s = 0.5\n"))
+    out = tmp_path / "res.parquet"
+    rep = run_sweep(spec, out, workers=1, traces=True)
+    tr = pd.read_parquet(rep.traces_out)
+    df = pd.read_parquet(out)
+    assert rep.traces_out == tmp_path / "res.traces.parquet"
+    assert set(tr["run_id"]) == set(df["run_id"])
+    one = tr[tr["run_id"] == df.loc[0, "run_id"]]
+    assert one["t_s"].tolist() == [0.0, 0.5, 1.0, 1.5, 2.0]
+    assert np.isclose(one["theta_deg"].max(), df.loc[0, "theta_max_deg"], atol=0.5)
+
+
+def test_fig8_local_physics():
+    """Fig. 8's trend: lower h0 gives a larger range and an earlier start."""
+    spec = parse_spec({"base": {"params": "paper2010-table2", "strategy": "open-loop",
+                                "voltage": "0:8:0,8:0:0", "t_end_s": 20.0},
+                       "vary": {"h0": {"fields": ["h0_heating_W_m2K", "h0_cooling_W_m2K"], "values": [60.0, 65.0, 70.0]}}})
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as d:
+        run_sweep(spec, Path(d) / "f8.parquet", workers=1)
+        df = pd.read_parquet(Path(d) / "f8.parquet")
+    assert df["theta_max_deg"].is_monotonic_decreasing and df["theta_max_deg"].iloc[0] > df["theta_max_deg"].iloc[-1]
+    assert df["motion_start_s"].is_monotonic_increasing
+
+
+# ---- CLI -----------------------------------------------------------------------------
+def _cli(args, cwd):
+    from typer.testing import CliRunner
+    import typer
+
+    from smafinger.cli_sweep import sweep
+
+    app = typer.Typer()
+    app.command("sweep")(sweep)
+    app.command("other")(lambda: None)  # keep 'sweep' as a sub-command
+    old = os.getcwd()
+    os.chdir(cwd)
+    try:
+        return CliRunner().invoke(app, ["sweep", *args])
+    finally:
+        os.chdir(old)
+
+
+def test_cli(tmp_path):
+    spec = _write(tmp_path, SMALL)
+    r = _cli([str(spec), "--workers", "1"], tmp_path)
+    assert r.exit_code == 0, r.output
+    assert "wrote spec.parquet: 6 runs (0 already done, 0 failed)" in r.output
+    assert (tmp_path / "spec.parquet").exists()
+    for args, msg in [
+        ([str(spec), "--out", "x.csv"], "--out x.csv: the results file must end in .parquet"),
+        ([str(spec), "--workers", "0"], "--workers 0: must be >= 1"),
+        ([str(tmp_path / "nope.toml")], "sweep spec not found"),
+        ([str(spec), "--scheduler", "tcp://127.0.0.1:1", "--workers", "2"], "--workers applies to local runs only"),
+        ([str(spec), "--out", str(tmp_path / "no" / "r.parquet")], "does not exist"),
+    ]:
+        r = _cli(args, tmp_path)
+        assert r.exit_code == 2, (args, r.output)
+        lines = [ln for ln in r.output.splitlines() if ln.startswith("smafinger: error:")]
+        assert len(lines) == 1 and msg in lines[0], r.output
+    bad = _write(tmp_path, _spec('[vary]\nh0_heating_W_m2K = [60.0, "x"]\n'), "bad.toml")
+    r = _cli([str(bad)], tmp_path)
+    assert r.exit_code == 2 and "h0_heating_W_m2K.values[1]: 'x' is not a number" in r.output
+    assert not (tmp_path / "bad.parquet").exists() and not (tmp_path / "bad.parquet.parts").exists()
+    # a file that is not a sweep table is never overwritten
+    (tmp_path / "other.parquet").write_bytes(b"not parquet")
+    r = _cli([str(spec), "--out", "other.parquet", "--workers", "1"], tmp_path)
+    assert r.exit_code == 2 and "is not a smafinger sweep table" in r.output
+    assert (tmp_path / "other.parquet").read_bytes() == b"not parquet"
