@@ -23,8 +23,12 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from ..parameters import ParameterSet
 
 #: sensible ranges (inclusive); values outside are refused as bad data
 TEMPERATURE_RANGE_C = (-100.0, 300.0)
@@ -257,3 +261,28 @@ def load_angle_curve(path: str | Path) -> AngleCurve:
         where = _where(path, n, data[-1][0]) if n else _where(path, line=head_ln)
         raise DataError(f"{where}: too few points: {n} data rows, at least {MIN_ROWS_JOINT} are needed")
     return AngleCurve(str(path), t, a, v)
+
+
+# ---------------------------------------------------------------------------------------
+# fitted parameter files
+# ---------------------------------------------------------------------------------------
+def parameter_file_text(values: dict[str, float], base: "str | ParameterSet", name: str, source: str) -> str:
+    """A parameter file (TOML) with fitted values, loadable by ``smafinger simulate --params``.
+
+    ``base`` a registry name: ``base = "NAME"`` plus the fitted fields. ``base`` a set (loaded
+    from a file, or with overrides): the complete set with the fitted fields replaced. Either
+    way the values are validated (ranges, cross-checks) first: ParameterError if invalid.
+    """
+    from ..parameters import ParameterSet, get
+
+    if isinstance(base, ParameterSet):
+        return base.replace(name=name, source=source, **values).to_toml()
+    get(base).replace(**values)  # validate
+    lines = ["# smafinger parameter file written by `smafinger identify` (SI units)",
+             f"base = {_q(base)}", f"name = {_q(name)}", f"source = {_q(source)}"]
+    lines += [f"{k} = {float(v)!r}" for k, v in values.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _q(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'

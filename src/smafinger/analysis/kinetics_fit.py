@@ -30,9 +30,9 @@ curve are strongly correlated, which this formula ignores; ``stderr_ar1`` inflat
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Callable, Sequence
 
 import numpy as np
@@ -52,6 +52,7 @@ KINETIC_FIELDS = ("A_S0_C", "A_F0_C", "M_S0_C", "M_F0_C", "c_A_Pa_per_C", "c_M_P
 _X_NAMES = ("A_S0", "wA", "M_F0", "wM", "c_A", "c_M", "eps_R", "D_M", "D_A")
 _X_LO = np.array([-100.0, 0.5, -100.0, 0.5, 0.5, 0.5, 0.01, 1.0, 1.0])
 _X_HI = np.array([300.0, 200.0, 300.0, 200.0, 200.0, 200.0, 20.0, 1000.0, 1000.0])
+MIN_STRESS_SPAN_MPA = 5.0  # below this spread of the curves' mean stresses, c_A and c_M are held
 _X_SCALE = np.array([5.0, 5.0, 5.0, 5.0, 1.0, 1.0, 0.2, 5.0, 5.0])
 
 
@@ -215,6 +216,8 @@ class KineticsFit:
     stress: str
     initial: KineticParams
     correlation: dict[str, dict[str, float]] = field(default_factory=dict)
+    at_bounds: list[str] = field(default_factory=list)  # fit-vector entries stuck at a bound
+    notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {
@@ -229,6 +232,9 @@ class KineticsFit:
             "message": self.message,
             "stress_model": self.stress,
             "initial": self.initial.as_dict(),
+            "correlation": self.correlation,
+            "at_bounds": self.at_bounds,
+            "notes": self.notes,
         }
 
 
@@ -257,6 +263,14 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
     base_kp = base if isinstance(base, KineticParams) else KineticParams.from_set(base)
     init = initial_guess(curves, base_kp)
     free = _free_mask(fit_moduli)
+    levels = [c.stress_MPa_mean for c in curves]
+    notes = []
+    if max(levels) - min(levels) < MIN_STRESS_SPAN_MPA:
+        # one stress level: the slopes, and D_M against eps_R, are not identifiable
+        free[4] = free[5] = free[7] = free[8] = False
+        init = dataclasses.replace(init, c_A_Pa_per_C=base_kp.c_A_Pa_per_C, c_M_Pa_per_C=base_kp.c_M_Pa_per_C)
+        notes.append(f"all curves at one stress level ({min(levels):.0f}-{max(levels):.0f} MPa): c_A, c_M, D_A and "
+                     f"D_M are held at the base values (fit two or more stress levels to identify them)")
     x_all = np.clip(init._x(), _X_LO + 1e-9, _X_HI - 1e-9)
     stresses = [curve_stress(c, stress) for c in curves]
     T = [np.ascontiguousarray(c.T_C, dtype=float) for c in curves]
@@ -304,7 +318,9 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
         den += float(rc @ rc)
     r1 = min(max(num / den if den > 0 else 0.0, 0.0), 0.99)
     infl = math.sqrt((1 + r1) / (1 - r1))
-    fitted = [f for f in KINETIC_FIELDS if not ((f == "D_A_Pa" and not free[8]) or (f == "D_M_Pa" and not free[7]))]
+    field_free = dict(zip(KINETIC_FIELDS, (free[0], free[0] or free[1], free[2] or free[3], free[2], free[4],
+                                           free[5], free[6], free[8], free[7])))
+    fitted = [f for f in KINETIC_FIELDS if field_free[f]]
     stderr = {f: float(se[i]) for i, f in enumerate(KINETIC_FIELDS) if f in fitted}
     stderr_ar1 = {f: v * infl for f, v in stderr.items()}
     corr = {}
@@ -317,30 +333,35 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
                 d = math.sqrt(cov[i, i] * cov[j, j])
                 corr[fi][fj] = float(cov[i, j] / d) if d > 0 else 0.0
     rms = {c.path: rms_strain(kp, c, stress) for c in curves}
+    names = [n for n, fr in zip(_X_NAMES, free) if fr]
+    span = _X_HI[free] - _X_LO[free]
+    at_bounds = [n for n, xi, lo_, hi_, sp in zip(names, res.x, _X_LO[free], _X_HI[free], span)
+                 if min(xi - lo_, hi_ - xi) < 1e-6 * sp]
     return KineticsFit(params=kp, stderr=stderr, stderr_ar1=stderr_ar1, fitted=fitted, rms=rms,
                        rms_all=float(np.sqrt(np.mean(r * r))), n_points=n, nfev=int(res.nfev),
                        success=bool(res.success), message=str(res.message), stress=stress, initial=init,
-                       correlation=corr)
+                       correlation=corr, at_bounds=at_bounds, notes=notes)
 
 
 def leave_one_out(curves: Sequence[StrainCurve], base: ParameterSet | KineticParams,
                   fit_moduli: Sequence[str] = ("D_M",), stress: str = "mean",
-                  on_fit: Callable[[str], None] | None = None,
-                  on_eval: Callable[[int], None] | None = None) -> list[dict]:
-    """Fit on all curves but one, predict the one left out; one entry per curve.
+                  on_fit: Callable[[int, str], None] | None = None) -> list[dict]:
+    """Fit on all curves but one, predict the one left out; one entry per curve (``path``,
+    ``stress_MPa``, ``rms_strain`` of the prediction, fitted ``values`` and ``params``).
 
-    Needs at least three curves (two remain to identify the stress slopes).
+    Needs at least three curves (two remain to identify the stress slopes); else ``[]``.
+    ``on_fit(i, name)`` is called after each fit.
     """
     if len(curves) < 3:
         return []
     out = []
     for i, c in enumerate(curves):
-        if on_fit is not None:
-            on_fit(c.name)
         rest = [d for j, d in enumerate(curves) if j != i]
-        f = fit_kinetics(rest, base, fit_moduli, stress, on_eval=on_eval)
+        f = fit_kinetics(rest, base, fit_moduli, stress)
         out.append({"path": c.path, "stress_MPa": c.stress_MPa_mean, "rms_strain": rms_strain(f.params, c, stress),
                     "values": f.params.as_dict(), "params": f.params})
+        if on_fit is not None:
+            on_fit(i, c.name)
     return out
 
 
@@ -361,35 +382,13 @@ def plausibility(kp: KineticParams) -> list[str]:
 # ---------------------------------------------------------------------------------------
 # output
 # ---------------------------------------------------------------------------------------
-def toml_text(values: dict[str, float], base: str | ParameterSet, name: str, source: str) -> str:
-    """A parameter file with the fitted fields.
-
-    ``base`` a registry name: ``base = "NAME"`` plus the fitted fields. ``base`` a set (e.g. one
-    loaded from a file): the complete set with the fitted fields replaced.
-    """
-    if isinstance(base, ParameterSet):
-        return base.replace(name=name, source=source, **values).to_toml()
-    lines = ["# smafinger parameter file written by `smafinger identify` (SI units)",
-             f'base = "{base}"', f"name = {_q(name)}", f"source = {_q(source)}"]
-    for k, v in values.items():
-        lines.append(f"{k} = {float(v)!r}")
-    return "\n".join(lines) + "\n"
-
-
-def _q(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
-
-
-def plot_kinetics(path: str | Path, fit: KineticsFit, fitted: Sequence[StrainCurve],
-                  validated: Sequence[StrainCurve] = (), loo: Sequence[dict] = ()) -> None:
+def kinetics_figure(fit: KineticsFit, fitted: Sequence[StrainCurve], validated: Sequence[StrainCurve] = (),
+                    loo: Sequence[dict] = ()):
     """Data vs model (strain in % against temperature), one panel per curve.
 
     Solid: the fit on all fitted curves; dashed: the leave-one-out prediction of that curve.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     items = [(c, "fitted") for c in fitted] + [(c, "validated") for c in validated]
     items.sort(key=lambda it: it[0].stress_MPa_mean)
@@ -397,7 +396,8 @@ def plot_kinetics(path: str | Path, fit: KineticsFit, fitted: Sequence[StrainCur
     n = len(items)
     ncol = 2 if n > 1 else 1
     nrow = math.ceil(n / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.8 * nrow), squeeze=False, sharex=True, sharey=True)
+    fig = Figure(figsize=(5.2 * ncol, 3.8 * nrow))
+    axes = fig.subplots(nrow, ncol, squeeze=False, sharex=True, sharey=True)
     for ax, (c, role) in zip(axes.flat, items):
         h = slice(0, c.split + 1)
         k = slice(c.split, c.n)
@@ -426,7 +426,4 @@ def plot_kinetics(path: str | Path, fit: KineticsFit, fitted: Sequence[StrainCur
                  f"M_F0 {p.M_F0_C:.1f} degC, c_A {p.c_A_Pa_per_C / 1e6:.2f}, c_M {p.c_M_Pa_per_C / 1e6:.2f} "
                  f"MPa/degC, eps_R {100 * p.eps_R:.2f}%", fontsize=9)
     fig.tight_layout()
-    from ..results import atomic_write
-
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip(".") or "png"))
-    plt.close(fig)
+    return fig

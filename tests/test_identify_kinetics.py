@@ -1,0 +1,151 @@
+"""Material kinetics fit (Eqs. 9-10) on synthetic curves and on the real thermal-cycling data."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import smafinger
+from smafinger.analysis.data import StrainCurve, load_strain_curve
+from smafinger.analysis.kinetics_fit import (
+    KineticParams, fit_kinetics, leave_one_out, model_curve, plausibility, rms_strain,
+)
+from smafinger.cli_identify import app
+from smafinger.parameters import get, resolve
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "sma-thermal-cycling"
+LEVELS = (50, 100, 172, 200)
+real_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"real data not found at {DATA}")
+
+TRUE = KineticParams(A_S0_C=62.0, A_F0_C=95.0, M_S0_C=73.0, M_F0_C=41.0, c_A_Pa_per_C=8.3e6,
+                     c_M_Pa_per_C=7.5e6, eps_R=0.039, D_A_Pa=75e9, D_M_Pa=28e9)
+
+
+def synthetic_curve(kp, stress_MPa, T_max=140.0, noise=0.0, seed=0, n=400):
+    T = np.concatenate([np.linspace(30, T_max, n // 2), np.linspace(T_max, 30, n // 2)[1:]])
+    sig = np.full(T.size, stress_MPa * 1e6)
+    c = StrainCurve(f"synthetic-{stress_MPa}MPa", T, np.zeros(T.size), sig, int(np.argmax(T)))
+    _, e = model_curve(kp, c)
+    e = e + noise * np.random.default_rng(seed).standard_normal(e.size)
+    return StrainCurve(c.path, T, e, sig, c.split)
+
+
+def test_recovers_known_kinetics_from_synthetic_curves():
+    curves = [synthetic_curve(TRUE, s, noise=2e-4, seed=i) for i, s in enumerate((60, 120, 190))]
+    fit = fit_kinetics(curves, get("paper2010"))  # start: the data-driven initial guess
+    got = fit.params
+    for k in ("A_S0_C", "A_F0_C", "M_S0_C", "M_F0_C"):
+        assert getattr(got, k) == pytest.approx(getattr(TRUE, k), abs=0.5), k
+    for k in ("c_A_Pa_per_C", "c_M_Pa_per_C", "eps_R"):
+        assert getattr(got, k) == pytest.approx(getattr(TRUE, k), rel=0.03), k
+    assert got.D_M_Pa == pytest.approx(TRUE.D_M_Pa, rel=0.15)
+    assert fit.rms_all == pytest.approx(2e-4, rel=0.15)  # down to the noise
+    # each parameter within ~3 standard errors of the truth
+    for k, se in fit.stderr.items():
+        assert abs(getattr(got, k) - getattr(TRUE, k)) < 4 * se + 1e-12, k
+    assert not plausibility(got)
+
+
+def test_minor_loop_keeps_xi_continuous_at_the_reversal():
+    # reversal at 85 degC, inside the austenite band: a minor loop
+    c = synthetic_curve(TRUE, 100.0, T_max=85.0)
+    xi, _ = model_curve(TRUE, c)
+    assert 0.05 < xi[c.split] < 0.95
+    steps = np.abs(np.diff(xi))
+    assert steps[c.split] <= steps.max() and steps[c.split] < 0.02  # no jump at the turn
+    assert np.all((xi >= 0) & (xi <= 1))
+    # on cooling xi first holds (above M_S) and then rises back to 1
+    assert xi[-1] == pytest.approx(1.0)
+    assert np.all(np.diff(xi[c.split + 1:]) >= -1e-12)
+
+
+@pytest.fixture(scope="module")
+def real_curves():
+    if not DATA.is_dir():
+        pytest.skip(f"real data not found at {DATA}")
+    return [load_strain_curve(DATA / f"filtered_data_{s}MPa.txt") for s in LEVELS]
+
+
+@pytest.fixture(scope="module")
+def real_cli(real_curves, tmp_path_factory):
+    d = tmp_path_factory.mktemp("kin")
+    out, rep, png = d / "fit.toml", d / "fit.json", d / "fit.png"
+    r = CliRunner().invoke(app, ["kinetics", *[c.path for c in real_curves], "--out", str(out), "--report",
+                                 str(rep), "--plot", str(png), "--no-progress"])
+    assert r.exit_code == 0, r.stderr
+    return r, out, json.loads(rep.read_text()), png
+
+
+@real_data
+def test_real_data_four_level_fit_is_plausible_and_close(real_cli):
+    r, out, rep, png = real_cli
+    v = rep["values"]
+    assert v["A_S0_C"] < v["A_F0_C"] and v["M_F0_C"] < v["M_S0_C"]
+    assert v["c_A_Pa_per_C"] > 0 and v["c_M_Pa_per_C"] > 0
+    # NiTi-like: slopes of a few MPa/degC, recoverable strain a few percent
+    assert 3e6 < v["c_A_Pa_per_C"] < 20e6 and 3e6 < v["c_M_Pa_per_C"] < 20e6
+    assert 0.02 < v["eps_R"] < 0.06
+    assert rep["plausible"] and not rep["at_bounds"]
+    assert {f["role"] for f in rep["files"]} == {"fitted"} and len(rep["files"]) == 4
+    for f in rep["files"]:
+        assert f["rms_strain"] < 2.5e-3  # measured: 1.99e-3 .. 2.14e-3
+    assert len(rep["leave_one_out"]) == 4
+    for d in rep["leave_one_out"]:
+        assert d["rms_strain"] < 2.6e-3  # measured: 2.10e-3 .. 2.29e-3
+    for k in ("A_S0_C", "A_F0_C", "M_S0_C", "M_F0_C", "c_A_Pa_per_C", "c_M_Pa_per_C", "eps_R", "D_M_Pa"):
+        assert rep["stderr"][k] > 0 and rep["stderr_ar1"][k] >= rep["stderr"][k]
+    assert png.stat().st_size > 20_000
+    assert "leave-one-level-out" in r.stdout
+
+
+@real_data
+def test_fitted_toml_is_a_parameter_file_simulate_accepts(real_cli):
+    _, out, rep, _ = real_cli
+    text = out.read_text()
+    assert 'base = "paper2010"' in text
+    p = resolve(str(out))
+    assert p.A_S0_C == pytest.approx(rep["values"]["A_S0_C"])
+    assert p.c_M_Pa_per_C == pytest.approx(rep["values"]["c_M_Pa_per_C"])
+    r = smafinger.simulate(str(out), strategy="open-loop", voltage="0:8:0", t_end_s=1.0, output_interval_s=0.01)
+    assert np.all(np.isfinite(r.theta_deg))
+    try:
+        from smafinger.cli import main
+    except ImportError:  # pragma: no cover
+        return
+    assert main(["simulate", "--params", str(out), "--strategy", "open-loop", "--voltage", "0:8:0",
+                 "--t-end", "0.5", "--no-progress"]) == 0
+
+
+@real_data
+def test_validate_files_are_predicted_not_fitted(real_curves, tmp_path):
+    fit_files = [c.path for c in real_curves if "172" not in c.path]
+    held = next(c.path for c in real_curves if "172" in c.path)
+    rep = tmp_path / "v.json"
+    r = CliRunner().invoke(app, ["kinetics", *fit_files, "--validate", held, "--no-loo", "--report", str(rep),
+                                 "--no-progress"])
+    assert r.exit_code == 0, r.stderr
+    d = json.loads(rep.read_text())
+    roles = {Path(f["path"]).name: f["role"] for f in d["files"]}
+    assert roles["filtered_data_172MPa.txt"] == "validated" and list(roles.values()).count("fitted") == 3
+    assert d["leave_one_out"] == []
+    # the held-out level is predicted as well as the leave-one-out check does
+    assert next(f["rms_strain"] for f in d["files"] if f["role"] == "validated") < 2.6e-3
+
+
+@real_data
+def test_library_leave_one_out_matches_a_fit_on_the_rest(real_curves):
+    base = get("paper2010")
+    loo = leave_one_out(real_curves[:3], base)
+    assert len(loo) == 3
+    fit = fit_kinetics(real_curves[1:3], base)
+    assert loo[0]["rms_strain"] == pytest.approx(rms_strain(fit.params, real_curves[0]), rel=1e-6)
+
+
+def test_one_stress_level_holds_the_slopes_and_moduli():
+    base = get("paper2010")
+    fit = fit_kinetics([synthetic_curve(TRUE, 100.0, noise=2e-4)], base)
+    assert "c_A_Pa_per_C" not in fit.fitted and "D_M_Pa" not in fit.fitted and fit.notes
+    assert fit.params.c_A_Pa_per_C == base.c_A_Pa_per_C and fit.params.D_M_Pa == base.D_M_Pa
+    assert set(fit.stderr) == set(fit.fitted)
