@@ -1,0 +1,81 @@
+"""``smafinger reproduce`` and ``smafinger scenarios`` from the command line (in process)."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+from smafinger.cli import main
+
+QUICK = ["fig8-h0-60-upper-v1", "fig8-h0-70-upper-v1"]
+
+
+def test_reproduce_only_two_scenarios_writes_every_output(tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["reproduce", "--out", str(out), "--workers", "2", "--no-progress"]
+    for n in QUICK:
+        argv += ["--only", n]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    assert "report.md" in printed
+
+    png = out / "fig08-h0.png"
+    assert png.exists() and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in out.glob("*.png")) == ["fig08-h0.png"]
+
+    for n in QUICK:
+        path = out / "runs" / f"{n}.csv"
+        with path.open() as f:
+            rows = list(csv.reader(f))
+        assert rows[0][:2] == ["t_s", "theta_deg"]
+        assert len(rows) - 1 == 4001  # 40 s every 10 ms
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert sorted(summary) == sorted(QUICK)
+    for n in QUICK:
+        entry = summary[n]
+        assert entry["interlock_violations"] == 0
+        assert entry["scenario"]["figure"] == "Fig. 8"
+        assert entry["derived"]["range_deg"] > 5.0
+        assert "segments" in entry
+    # h0 = 60 moves further than h0 = 70
+    assert summary[QUICK[0]]["derived"]["range_deg"] > summary[QUICK[1]]["derived"]["range_deg"]
+
+    report = (out / "report.md").read_text()
+    assert "| Figure | Claim | Paper | smafinger | Holds | Note |" in report
+    assert "lower h0 -> larger range and earlier start of motion (upper wire)" in report
+    assert "not run" in report  # Fig. 15 was not selected
+    assert not (out / "investigation.json").exists()
+
+
+def test_reproduce_glob_selection_serial(tmp_path):
+    out = tmp_path / "o"
+    assert main(["reproduce", "--out", str(out), "--only", "fig13-extension-*", "--workers", "1",
+                 "--no-progress"]) == 0
+    assert (out / "fig13.png").exists()
+    assert sorted(p.stem for p in (out / "runs").glob("*.csv")) == [
+        "fig13-extension-case1-v1", "fig13-extension-case2-v1"]
+    assert "extension: return from -30 to -40 deg faster" in (out / "report.md").read_text()
+
+
+def test_reproduce_unknown_scenario_is_a_usage_error(tmp_path, capsys):
+    assert main(["reproduce", "--out", str(tmp_path / "x"), "--only", "fig99-v1"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown scenario 'fig99-v1'" in err and "fig15-cooperative-v1" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_scenarios_lists_names_and_figures(capsys):
+    assert main(["scenarios"]) == 0
+    out = capsys.readouterr().out
+    assert "fig15-independent-v1" in out and "Fig. 15" in out
+    assert "authors2020-profile2-v1" in out
+    assert main(["scenarios", "-v"]) == 0
+    assert "friction_sticking=initial-only" in capsys.readouterr().out
+
+
+def test_simulate_runs_a_named_scenario(tmp_path, capsys):
+    csv_path = tmp_path / "r.csv"
+    assert main(["simulate", "--scenario", "fig12-extension-v1", "--out", str(csv_path), "--no-progress"]) == 0
+    assert csv_path.exists()
+    assert "interlock violations 0" in capsys.readouterr().out
