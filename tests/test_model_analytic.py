@@ -113,7 +113,7 @@ def test_minor_loops_continuous_and_bounded(temps, sigma):
 def hand_arm(B, P):
     """Distance from O to the line through P and B (Eqs. 4b/5b written as a cross product)."""
     d = np.subtract(B, P)
-    return abs(np.cross(P, d)) / np.linalg.norm(d)
+    return abs(P[0] * d[1] - P[1] * d[0]) / np.linalg.norm(d)
 
 
 def test_moment_arms_and_paths_at_minus_40_deg():

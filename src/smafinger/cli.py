@@ -9,7 +9,7 @@ from typing import List, Optional
 
 import typer
 
-from .engine.run import DEFAULT_DT_S, DEFAULT_OUTPUT_S, SimulationError, make_spec, run_spec
+from .engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, SimulationError, make_spec, run_spec
 from .parameters import ParameterError, names, resolve
 from .profiles import ProfileError
 
@@ -42,7 +42,7 @@ def simulate(
     voltage: Optional[str] = typer.Option(None, "--voltage", help='open-loop program "T:V_UPPER:V_LOWER,..."'),
     t_end: float = typer.Option(20.0, "--t-end", help="simulated time [s]"),
     dt: float = typer.Option(DEFAULT_DT_S, "--dt", help="integration step [s]"),
-    method: str = typer.Option("rk4", "--method", help="rk4 | euler"),
+    method: str = typer.Option(DEFAULT_METHOD, "--method", help="rk4 | euler"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", help="output sampling [s]"),
     tol_deg: float = typer.Option(0.5, "--tol-deg", help="target tolerance [deg]"),
     hold_s: float = typer.Option(0.5, "--hold-s", help="time the joint must stay within tolerance [s]"),

@@ -34,7 +34,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
-from .engine.run import DEFAULT_DT_S, DEFAULT_OUTPUT_S, RunSpec, make_spec
+from .engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, RunSpec, make_spec
 from .parameters import ParameterSet, get as get_params
 
 #: the friction reading of Sec. 3.1, applied to every scenario of the paper
@@ -68,7 +68,7 @@ class Scenario:
         """The scenario's parameter set, with its own overrides and then ``overrides``."""
         return get_params(self.params).with_overrides(list(self.overrides) + list(overrides or ()))
 
-    def spec(self, overrides: Iterable[str] = (), dt_s: float = DEFAULT_DT_S, method: str = "rk4",
+    def spec(self, overrides: Iterable[str] = (), dt_s: float = DEFAULT_DT_S, method: str = DEFAULT_METHOD,
              output_interval_s: float = DEFAULT_OUTPUT_S, tol_deg: float = 0.5, hold_s: float = 0.5,
              *, profile: str | None = None, t_end_s: float | None = None,
              independent_wait: bool | None = None, strategy: str | None = None) -> RunSpec:
