@@ -8,11 +8,14 @@ it is reported, not bent, and the marker has to go if the model ever reproduces 
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
+import numpy as np
 import pytest
 
 from smafinger import scenarios
 from smafinger.engine.run import run_spec
-from smafinger.reproduce import cycle_time, openloop_metrics, segment_metrics
+from smafinger.reproduce import cooling_phase_metrics, cycle_time, openloop_metrics, segment_metrics
 
 
 @pytest.fixture(scope="module")
@@ -94,12 +97,39 @@ def test_fig8_lower_h0_larger_range_and_earlier_start(runs, wire):
 
 
 # ---- Fig. 11: controller off in the cooling phase -> faster return, larger overshoot ------------
+def test_fig11_controller_off_cools_faster_but_overshoots_more(runs):
+    """v2 reading: the cooling phase is the joint past -30 deg during the extension (Sec. 2.6),
+    wire and surroundings at the authors' 60 degC."""
+    on = cooling_phase_metrics(runs["fig11-controller-on-v2"], -30.0)
+    off = cooling_phase_metrics(runs["fig11-controller-off-v2"], -30.0)
+    assert on["cooling_s"] is not None and off["cooling_s"] is not None
+    # "a relatively faster cooling": shorter, and the wire's temperature falls faster
+    assert off["cooling_s"] < 0.8 * on["cooling_s"], (on, off)
+    assert off["cooling_rate_C_s"] > 1.5 * on["cooling_rate_C_s"], (on, off)
+    # "a tendency to overshoot the desired joint position": falls further below -30 deg
+    assert off["overshoot_after_deg"] > max(2.0 * on["overshoot_after_deg"], 0.02), (on, off)
+
+
+def test_cooling_phase_metrics_on_a_known_signal():
+    t = np.arange(0.0, 10.0, 0.01)
+    theta = np.where(t < 2.0, -40.0 + 5.0 * t, -30.0 + 0.2 * np.sin(np.pi * (t - 2.0) / 3.0))
+    T = 90.0 - 2.0 * t
+    m = cooling_phase_metrics(SimpleNamespace(t=t, theta_deg=theta, T_upper_C=T), -30.0)
+    assert m["cooling_start_s"] == pytest.approx(2.01)
+    assert m["cooling_s"] == pytest.approx(3.0, abs=0.011)
+    assert m["cooling_rate_C_s"] == pytest.approx(2.0)
+    assert m["peak_past_deg"] == pytest.approx(0.2, abs=1e-3)
+    assert m["overshoot_after_deg"] == pytest.approx(0.2, abs=1e-3)
+    flat = cooling_phase_metrics(SimpleNamespace(t=t, theta_deg=np.full_like(t, -35.0), T_upper_C=T), -30.0)
+    assert flat["cooling_s"] is None and flat["peak_past_deg"] == 0.0
+
+
 @pytest.mark.xfail(strict=True, reason=(
-    "not reproduced: return to -40 deg 5.51 s (on) vs 5.58 s (off), overshoot 0.030 deg both. "
+    "v1 reading (cooling phase = the return to -40 deg, 23 degC) not reproduced: return to -40 deg 5.51 s (on) vs 5.58 s (off), overshoot 0.030 deg both. "
     "With K_P = K_V and the integral reset at the new target the PID output stays negative during "
     "the return, so 'on' applies 0 V too; the -30 deg target is approached without overshoot. "
     "See report.md (Fig. 11)."))
-def test_fig11_controller_off_returns_faster_but_overshoots_more(runs):
+def test_fig11_v1_controller_off_returns_faster_but_overshoots_more(runs):
     on = runs["fig11-controller-on-v1"]
     off = runs["fig11-controller-off-v1"]
     r_on, r_off = segment_metrics(on, 1), segment_metrics(off, 1)

@@ -201,6 +201,34 @@ def segment_metrics(result: SimulationResult, index: int, summary: dict | None =
     return out
 
 
+def cooling_phase_metrics(result: SimulationResult, target_deg: float, window_s: float = 5.0) -> dict:
+    """Fig. 11: the agonist's first cooling phase after the joint passes ``target_deg``.
+
+    The cooling phase (Sec. 2.6) is the first run of samples with theta > theta_F (upper
+    wire). Returned: its start and duration [s], the mean fall of the upper wire's
+    temperature over it [degC/s], the peak past the target before it [deg] and the
+    overshoot below the target in the ``window_s`` after it ends [deg]. ``None`` values
+    when the joint never passes the target.
+    """
+    t, th, T = result.t, result.theta_deg, result.T_upper_C
+    above = th > target_deg
+    out: dict[str, Any] = {"cooling_start_s": None, "cooling_s": None, "cooling_rate_C_s": None,
+                           "peak_past_deg": float(max(th.max() - target_deg, 0.0)),
+                           "overshoot_after_deg": None}
+    if not above.any():
+        return out
+    i0 = int(np.argmax(above))
+    below = np.flatnonzero(~above[i0:])
+    i1 = i0 + int(below[0]) if below.size else len(t) - 1
+    dur = float(t[i1] - t[i0])
+    w = (t >= t[i1]) & (t <= t[i1] + window_s)
+    out.update(cooling_start_s=float(t[i0]), cooling_s=dur,
+               cooling_rate_C_s=float((T[i0] - T[i1]) / dur) if dur > 0 else None,
+               peak_past_deg=float(th[i0:i1 + 1].max() - target_deg),
+               overshoot_after_deg=float(max(target_deg - th[w].min(), 0.0)) if below.size else None)
+    return out
+
+
 def cycle_time(summary: dict) -> float | None:
     """Time from 0 at which the last target is reached (start of the last segment plus its
     ``reached_s``); None if a segment never started or the last target was never reached.
@@ -232,6 +260,8 @@ def derived_metrics(run: Run) -> dict:
     if "return_segment" in s.meta:
         out["return"] = segment_metrics(r, s.meta["return_segment"], run.summary)
         out["move"] = segment_metrics(r, 0, run.summary)
+    elif "target_deg" in s.meta:
+        out["cooling_phase"] = cooling_phase_metrics(r, s.meta["target_deg"])
     return out
 
 
@@ -295,29 +325,41 @@ def plot_openloop(runs: list[Run], title: str, path: Path) -> None:
     _save(fig, path)
 
 
-def plot_fig11(runs: list[Run], path: Path) -> None:
+def plot_fig11(runs: list[Run], path: Path, title: str, panel: str, zoom_deg: float | None = None) -> None:
+    """Angle (and, with ``zoom_deg``, a close-up of +-zoom_deg around the target) and the
+    upper wire's temperature, controller on vs off in the cooling phase."""
     plt = _plt()
-    fig, ax = plt.subplots(2, 1, figsize=(7.5, 7), sharex=True, constrained_layout=True)
+    rows = 3 if zoom_deg else 2
+    fig, ax = plt.subplots(rows, 1, figsize=(7.5, 3.2 * rows + 0.6), sharex=True, constrained_layout=True)
     colors = {True: "tab:blue", False: "tab:orange"}
     first = True
+    target = None
     for r in runs:
         if not r.ok:
             continue
         on = r.scenario.meta["controller_in_cooling"]
         res = r.result
+        axes = [ax[0], ax[1]] if zoom_deg else [ax[0]]
         if first:
-            ax[0].plot(res.t, res.theta_ref_deg, color="k", ls="--", lw=1.0, label=r"target $\theta_F$")
+            for a in axes:
+                a.plot(res.t, res.theta_ref_deg, color="k", ls="--", lw=1.0, label=r"target $\theta_F$")
+            target = float(res.theta_ref_deg[-1])
             first = False
-        ax[0].plot(res.t, res.theta_deg, color=colors[on], ls="-" if on else "-.", label=r.scenario.label)
-        ax[1].plot(res.t, res.T_upper_C, color=colors[on], ls="-" if on else "-.", label=r.scenario.label)
+        for a in axes:
+            a.plot(res.t, res.theta_deg, color=colors[on], ls="-" if on else "-.", label=r.scenario.label)
+        ax[-1].plot(res.t, res.T_upper_C, color=colors[on], ls="-" if on else "-.", label=r.scenario.label)
     ax[0].set_ylabel(r"Joint angle $\theta$ [deg]")
-    ax[0].set_title("(a) Extension -40 -> -30 deg with the upper actuator, then its cooling phase")
-    ax[1].set_ylabel("Upper wire temperature [°C]")
-    ax[1].set_xlabel("Time [s]")
-    ax[1].set_title("(b) Upper (agonist) wire temperature")
+    ax[0].set_title(panel)
+    if zoom_deg and target is not None:
+        ax[1].set_ylim(target - zoom_deg, target + zoom_deg)
+        ax[1].set_ylabel(r"Joint angle $\theta$ [deg]")
+        ax[1].set_title(f"(b) Close-up: within {zoom_deg:g} deg of the target")
+    ax[-1].set_ylabel("Upper wire temperature [°C]")
+    ax[-1].set_xlabel("Time [s]")
+    ax[-1].set_title(f"({'c' if zoom_deg else 'b'}) Upper (agonist) wire temperature")
     for a in ax:
         a.legend(loc="best")
-    fig.suptitle("Fig. 11: controlled (i) vs uncontrolled (ii) cooling phase (paper2010, update 0.01 s)")
+    fig.suptitle(title)
     _save(fig, path)
 
 
@@ -452,7 +494,14 @@ def plot_group(group: str, runs: list[Run], out_dir: Path) -> Path | None:
     if group in _OPENLOOP_TITLES:
         plot_openloop(runs, _OPENLOOP_TITLES[group], path)
     elif group == "fig11":
-        plot_fig11(runs, path)
+        plot_fig11(runs, path, "Fig. 11: controlled (i) vs uncontrolled (ii) cooling phase "
+                   "(paper2010, update 0.01 s, wire at 60 °C)",
+                   "(a) Extension -40 -> -30 deg with the upper actuator (cooling phase: joint past -30 deg)",
+                   zoom_deg=0.3)
+    elif group == "fig11-return":
+        plot_fig11(runs, path, "Fig. 11, first reading (v1): cooling phase = return to -40 deg, "
+                   "23 °C (not reproduced)",
+                   "(a) Extension -40 -> -30 deg with the upper actuator, then back to -40 deg")
     elif group == "fig12":
         plot_fig12(runs, path)
     elif group == "fig13":
@@ -669,6 +718,27 @@ def make_claims(runs: dict[str, Run], derived: dict[str, dict]) -> list[Claim]:
                                 "" if not ok or r1 is None else f"{_pct(1 - r2 / r1)} faster"))
 
     # ---- Fig. 11 ----------------------------------------------------------------------
+    on, off = runs.get("fig11-controller-on-v2"), runs.get("fig11-controller-off-v2")
+    if on and off and on.ok and off.ok:
+        con, coff = D[on.key]["cooling_phase"], D[off.key]["cooling_phase"]
+        have = con["cooling_s"] is not None and coff["cooling_s"] is not None
+        faster = have and coff["cooling_s"] < con["cooling_s"]
+        larger = (have and coff["overshoot_after_deg"] is not None
+                  and coff["overshoot_after_deg"] > (con["overshoot_after_deg"] or 0.0))
+        claims.append(Claim(
+            "Fig. 11", "controller off in the cooling phase: relatively faster cooling, but a "
+            "tendency to overshoot the target (v2: cooling phase = joint past -30 deg; wire at 60 °C)",
+            "(ii) cools faster than (i), and overshoots",
+            (f"cooling phase: on {_f(con['cooling_s'], '.2f')} at {_f(con['cooling_rate_C_s'], '.1f', ' °C/s')}, "
+             f"off {_f(coff['cooling_s'], '.2f')} at {_f(coff['cooling_rate_C_s'], '.1f', ' °C/s')}; "
+             f"overshoot below -30 deg after it: on {_f(con['overshoot_after_deg'], '.3f', ' deg')}, "
+             f"off {_f(coff['overshoot_after_deg'], '.3f', ' deg')}") if have else "the joint never passed -30 deg",
+            "yes" if faster and larger else ("partly" if faster or larger else "no"),
+            ("holds only with the authors' 60 °C; at the paper's 23 °C the joint passes -30 deg by "
+             "0.001 deg, so there is hardly a cooling phase to control (v1 row below). The "
+             "overshoot is small in degrees: the PID's derivative term (K_V/K_P = 1 s) brakes "
+             "the approach")))
+
     on, off = runs.get("fig11-controller-on-v1"), runs.get("fig11-controller-off-v1")
     if on and off and on.ok and off.ok:
         ron, roff = D[on.key]["return"], D[off.key]["return"]
@@ -685,7 +755,8 @@ def make_claims(runs: dict[str, Run], derived: dict[str, dict]) -> list[Claim]:
         duty_ret = float(np.max(res.duty_upper[m_ret])) if m_ret.any() else float("nan")
         past = float(np.max(res.theta_deg[~m_ret])) + 30.0
         claims.append(Claim(
-            "Fig. 11", "controller off in the cooling phase: faster cooling, but overshoots the target",
+            "Fig. 11", "first reading (v1): cooling phase = the return from -30 to -40 deg at 23 °C; "
+            "controller off: faster, but overshoots",
             "(ii) faster than (i), with overshoot",
             f"return to -40 deg: on {_f(ron['reached_s'], '.2f')}, off {_f(roff['reached_s'], '.2f')}; "
             f"largest overshoot: on {ovon:.3f} deg, off {ovoff:.3f} deg; upper-wire energy on {eu[0]:.0f} J, "

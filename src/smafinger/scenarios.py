@@ -195,9 +195,34 @@ for _on, _lab in ((True, "on"), (False, "off")):
         profile=f"0:-30:upper,{MOVE_S:g}:-40:upper",
         t_end_s=2.5 * MOVE_S,
         overrides=(PAPER_FRICTION, f"controller_in_cooling={str(_on).lower()}", "controller_update_s=0.01"),
-        group="fig11",
+        group="fig11-return",
         label=("(i) controller on in cooling" if _on else "(ii) controller off in cooling"),
         meta={"controller_in_cooling": _on, "return_segment": 1},
+    ))
+# v2: the reading that reproduces the figure. The cooling phase is the upper wire's own
+# (Sec. 2.6: theta > theta_F) while the joint falls back after passing -30 deg during the
+# extension; the wire starts at and cools towards the 60 degC of the authors' model
+# (MODEL-NOTES; Sec. 3.2: the air around the wire stays above the room's T_amb). At the
+# paper's 23 degC the PID approaches -30 deg with 0.001 deg of overshoot, so the wire
+# hardly enters its cooling phase and the two cases cannot differ (see docs/reproduce.md).
+FIG11_WARM_C = 60.0
+for _on, _lab in ((True, "on"), (False, "off")):
+    _add(Scenario(
+        name=f"fig11-controller-{_lab}-v2",
+        figure="Fig. 11",
+        description=(f"Fig. 11, Sec. 4.1: extension -40 -> -30 deg with the upper actuator only; "
+                     f"controller {'kept on' if _on else 'switched off'} in the upper wire's cooling "
+                     f"phase (joint past the target), update 0.01 s; wire and surroundings at "
+                     f"{FIG11_WARM_C:g} degC as in the authors' model"),
+        params="paper2010",
+        strategy="independent",
+        profile="0:-30:upper",
+        t_end_s=20.0,
+        overrides=(PAPER_FRICTION, f"controller_in_cooling={str(_on).lower()}", "controller_update_s=0.01",
+                   f"T_init_C={FIG11_WARM_C:g}", f"T_amb_C={FIG11_WARM_C:g}"),
+        group="fig11",
+        label=("(i) controller on in cooling" if _on else "(ii) controller off in cooling"),
+        meta={"controller_in_cooling": _on, "target_deg": -30.0},
     ))
 
 # ---------------------------------------------------------------------------------------
