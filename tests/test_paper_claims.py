@@ -8,6 +8,7 @@ it is reported, not bent, and the marker has to go if the model ever reproduces 
 
 from __future__ import annotations
 
+import re
 from types import SimpleNamespace
 
 import numpy as np
@@ -40,9 +41,9 @@ def test_registry_names_are_versioned_and_cite_a_figure():
     assert len(names) == len(set(names)) >= 40
     for n in names:
         s = scenarios.get(n)
-        assert n.endswith("-v1") and s.name == n
+        assert re.search(r"-v[0-9]+$", n) and s.name == n, n
         assert s.figure and s.description
-    for required in ("fig8-h0-60-upper-v1", "fig11-controller-off-v1", "fig15-independent-v1",
+    for required in ("fig8-h0-60-upper-v1", "fig11-controller-off-v1", "fig11-controller-off-v2", "fig15-independent-v1",
                      "fig15-cooperative-v1", "authors2020-profile1-v1", "authors2020-profile2-v1"):
         assert required in names
 

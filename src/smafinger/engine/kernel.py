@@ -15,6 +15,7 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from ..control.pid import pid_output
 from ..control.strategies import (
@@ -30,12 +31,12 @@ from ..model.layout import (
     P_xlim_u,
 )
 from ..model.kinematics import both_tendons
-from ..model.layout import P_a0_l, P_a0_u, P_a1, P_a2, P_a4, P_a5, P_r
+from ..model.layout import N_PARAMS, P_a0_l, P_a0_u, P_a1, P_a2, P_a4, P_a5, P_r
 from .rhs import (
     A_BL, A_BU, A_ME, A_SL, A_SU, A_XIL, A_XIU, A_XL, A_XU, D_BRL, D_BRU, D_CDF, D_HEATL,
-    D_HEATU, D_INTON, D_STL, D_STU, D_STUCK, D_THF, D_VL, D_VU, D_XHL, D_XHU, N_AUX, N_DISC, N_STATE,
+    D_HEATU, D_INTON, D_STL, D_STU, D_STUCK, D_THF, D_VL, D_VU, D_XHL, D_XHU, N_DISC, N_STATE,
     Y_EL, Y_EU, Y_INT, Y_OMEGA, Y_SL, Y_SU, Y_THETA, Y_TL, Y_TU, _xi, algebraic_stress,
-    evaluate, integrate_rest, wire_temperature_rate,
+    _kin_at, evaluate, integrate_rest, kinematics, wire_temperature_rate,
 )
 
 # output columns
@@ -54,16 +55,14 @@ STATUS_BLOWUP = 1
 
 
 @njit(cache=True)
-def _wire_xi_sigma(y, d, p, upper):
-    """xi and sigma of one wire at state y on the branch held in d."""
-    if upper:
-        T = y[Y_TU]
-        br, st, xh = d[D_BRU], d[D_STU], d[D_XHU]
-    else:
-        T = y[Y_TL]
-        br, st, xh = d[D_BRL], d[D_STL], d[D_XHL]
+def _wire_xi_sigma(theta, T, s, br, st, xh, p, upper):
+    """xi and sigma of one wire (temperature T, stress state s) at angle theta on branch br.
+
+    Computed only where needed (a branch change, the independent strategy's release test):
+    a pure function of its arguments, so the same bits whenever it is evaluated.
+    """
     if p[P_stress_algebraic] != 0.0:
-        pu, _, _, pl, _, _ = both_tendons(y[Y_THETA], p[P_r], p[P_a0_u], p[P_a0_l], p[P_a1],
+        pu, _, _, pl, _, _ = both_tendons(theta, p[P_r], p[P_a0_u], p[P_a0_l], p[P_a1],
                                           p[P_a2], p[P_a4], p[P_a5])
         if upper:
             eps = p[P_eps_tot0_u] + (pu - p[P_path0_u]) / p[P_L_w]
@@ -72,21 +71,36 @@ def _wire_xi_sigma(y, d, p, upper):
             eps = p[P_eps_tot0_l] + (pl - p[P_path0_l]) / p[P_L_w]
             s, xi, _ = algebraic_stress(eps, T, br, st, xh, p, p[P_xlim_l])
         return xi, s
-    s = y[Y_SU] if upper else y[Y_SL]
     return _xi(br, st, xh, T, s, p)[0], s
 
 
 @njit(cache=True)
-def _update_branch(d, i_br, i_st, i_xh, dT, xi_now, T, sigma, p, turn, side):
-    """Select the kinetics branch; re-solve the start value on a change (minor loops)."""
-    nb, turn[side] = next_branch(int(d[i_br]), dT, T, turn[side], p[P_reversal])
-    if nb != int(d[i_br]):
+def _wire_xi(y, d, p, upper):
+    """xi of one wire at state y on the branch held in d (tuples, as in evaluate)."""
+    if upper:
+        return _wire_xi_sigma(y[Y_THETA], y[Y_TU], y[Y_SU], d[D_BRU], d[D_STU], d[D_XHU], p,
+                              True)[0]
+    return _wire_xi_sigma(y[Y_THETA], y[Y_TL], y[Y_SL], d[D_BRL], d[D_STL], d[D_XHL], p,
+                          False)[0]
+
+
+@njit(cache=True, inline="always")
+def _update_branch(br, st, xh, dT, theta, T, s, p, turn, upper):
+    """Select the kinetics branch; re-solve the start value on a change (minor loops).
+
+    xi and sigma at the reversal are those of the state (theta, T, s) on the old branch.
+    Returns the new (branch, start value, held xi, turning temperature).
+    """
+    nb, turn = next_branch(int(br), dT, T, turn, p[P_reversal])
+    if nb != int(br):
+        xi_now, sigma = _wire_xi_sigma(theta, T, s, br, st, xh, p, upper)
         if nb == HOLD:
-            d[i_xh] = xi_now
+            xh = xi_now
         else:
-            d[i_st] = branch_start(nb, xi_now, T, sigma, p[P_A_S0], p[P_A_F0], p[P_c_A],
-                                   p[P_M_S0], p[P_M_F0], p[P_c_M])
-        d[i_br] = nb
+            st = branch_start(nb, xi_now, T, sigma, p[P_A_S0], p[P_A_F0], p[P_c_A],
+                              p[P_M_S0], p[P_M_F0], p[P_c_M])
+        br = float(nb)
+    return br, st, xh, turn
 
 
 @njit(cache=True, nogil=True)
@@ -114,11 +128,14 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
     d[D_STU] = p[P_xi_init]
     d[D_STL] = p[P_xi_init]
     d[D_INTON] = 1.0
-    turn = np.array([p[P_T_init], p[P_T_init]])
-    work = np.zeros((5, N_STATE))
-    aux = np.zeros(N_AUX)
-    xi_u, sig_u = _wire_xi_sigma(y, d, p, True)
-    xi_l, sig_l = _wire_xi_sigma(y, d, p, False)
+    turn_u = p[P_T_init]
+    turn_l = p[P_T_init]
+    # the hot path works on tuples of floats (parameters, state, discrete inputs): passed by
+    # value, they need no reference counting, unlike arrays
+    pt = to_fixed_tuple(p, N_PARAMS)
+    kin_theta = y[Y_THETA]
+    kin = kinematics(kin_theta, pt)
+    bounds = np.empty(3)
 
     nseg = seg_start.shape[0]
     nvolt = volt_ticks.shape[0]
@@ -171,8 +188,9 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
                     en_l = True
                 elif en == AUTO and strategy == INDEPENDENT:
                     ag = independent_agonist(theta_F, y[Y_THETA], agonist)
-                    prev_xi = xi_u if agonist == UPPER else xi_l
-                    if wait_release and agonist != NONE and ag != agonist and prev_xi < RELEASE_XI:
+                    if (wait_release and agonist != NONE and ag != agonist
+                            and _wire_xi(to_fixed_tuple(y, N_STATE), to_fixed_tuple(d, N_DISC), pt,
+                                         agonist == UPPER) < RELEASE_XI):
                         waiting = True
                         wait_side = agonist
                         pending = ag
@@ -192,7 +210,8 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
             else:
                 break
         if waiting:
-            w_xi = xi_u if wait_side == UPPER else xi_l
+            w_xi = _wire_xi(to_fixed_tuple(y, N_STATE), to_fixed_tuple(d, N_DISC), pt,
+                            wait_side == UPPER)
             if w_xi >= RELEASE_XI:
                 waiting = False
                 en_u = pending == UPPER
@@ -250,7 +269,6 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
         e2 = ps + on_l if 0.0 < duty_l < 100.0 else -1.0
         if e1 > e2:
             e1, e2 = e2, e1
-        bounds = np.empty(3)
         nb = 0
         if e1 > t and e1 < t_next:
             bounds[nb] = e1
@@ -271,13 +289,18 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
             d[D_VL] = Vl
             if Vu > V_L and Vl > V_L and b > a:
                 counters[C_VIOLATIONS] += 1
-            dTu = wire_temperature_rate(y[Y_TU], Vu, heat_u, p)
-            dTl = wire_temperature_rate(y[Y_TL], Vl, heat_l, p)
-            _update_branch(d, D_BRU, D_STU, D_XHU, dTu, xi_u, y[Y_TU], sig_u, p, turn, 0)
-            _update_branch(d, D_BRL, D_STL, D_XHL, dTl, xi_l, y[Y_TL], sig_l, p, turn, 1)
+            dTu = wire_temperature_rate(y[Y_TU], Vu, heat_u, pt)
+            dTl = wire_temperature_rate(y[Y_TL], Vl, heat_l, pt)
+            d[D_BRU], d[D_STU], d[D_XHU], turn_u = _update_branch(
+                d[D_BRU], d[D_STU], d[D_XHU], dTu, y[Y_THETA], y[Y_TU], y[Y_SU], pt, turn_u, True)
+            d[D_BRL], d[D_STL], d[D_XHL], turn_l = _update_branch(
+                d[D_BRL], d[D_STL], d[D_XHL], dTl, y[Y_THETA], y[Y_TL], y[Y_SL], pt, turn_l, False)
             d[D_STUCK] = 1.0 if stuck else 0.0
-            k1 = work[0]
-            evaluate(y, d, p, k1, aux)
+            yt = to_fixed_tuple(y, N_STATE)
+            dv = to_fixed_tuple(d, N_DISC)
+            kin = _kin_at(yt[Y_THETA], kin_theta, kin, pt)
+            kin_theta = yt[Y_THETA]
+            k1, aux = evaluate(yt, dv, pt, kin)
             counters[C_EVALS] += 1
             # ---- stick / slip (Eq. 2) ------------------------------------------------
             me = abs(aux[A_ME])
@@ -298,42 +321,45 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
                     counters[C_STICKS] += 1
                 stuck = new_stuck
                 d[D_STUCK] = 1.0 if stuck else 0.0
-                evaluate(y, d, p, k1, aux)
+                yt = to_fixed_tuple(y, N_STATE)
+                dv = to_fixed_tuple(d, N_DISC)
+                k1, aux = evaluate(yt, dv, pt, kin)
                 counters[C_EVALS] += 1
             omega_prev = y[Y_OMEGA]
             # ---- output sample at t -----------------------------------------------------
             if j == 0 and t == next_out and out_i < n_out:
-                row = out[out_i]
-                row[0] = t * tick_s
-                row[1] = y[Y_THETA]
-                row[2] = theta_F
-                row[3] = y[Y_OMEGA]
-                row[4] = y[Y_TU]
-                row[5] = y[Y_TL]
-                row[6] = aux[A_XIU]
-                row[7] = aux[A_XIL]
-                row[8] = aux[A_SU]
-                row[9] = aux[A_SL]
-                row[10] = aux[A_BU]
-                row[11] = aux[A_BL]
-                row[12] = aux[A_XU]
-                row[13] = aux[A_XL]
-                row[14] = Vu
-                row[15] = Vl
-                row[16] = duty_u
-                row[17] = duty_l
-                row[18] = y[Y_EU]
-                row[19] = y[Y_EL]
-                row[20] = next_seg - 1
-                row[21] = 1.0 if en_u else 0.0
-                row[22] = 1.0 if en_l else 0.0
-                row[23] = 1.0 if stuck else 0.0
-                row[24] = 1.0 if heat_u else 0.0
-                row[25] = 1.0 if heat_l else 0.0
+                out[out_i, 0] = t * tick_s
+                out[out_i, 1] = y[Y_THETA]
+                out[out_i, 2] = theta_F
+                out[out_i, 3] = y[Y_OMEGA]
+                out[out_i, 4] = y[Y_TU]
+                out[out_i, 5] = y[Y_TL]
+                out[out_i, 6] = aux[A_XIU]
+                out[out_i, 7] = aux[A_XIL]
+                out[out_i, 8] = aux[A_SU]
+                out[out_i, 9] = aux[A_SL]
+                out[out_i, 10] = aux[A_BU]
+                out[out_i, 11] = aux[A_BL]
+                out[out_i, 12] = aux[A_XU]
+                out[out_i, 13] = aux[A_XL]
+                out[out_i, 14] = Vu
+                out[out_i, 15] = Vl
+                out[out_i, 16] = duty_u
+                out[out_i, 17] = duty_l
+                out[out_i, 18] = y[Y_EU]
+                out[out_i, 19] = y[Y_EL]
+                out[out_i, 20] = next_seg - 1
+                out[out_i, 21] = 1.0 if en_u else 0.0
+                out[out_i, 22] = 1.0 if en_l else 0.0
+                out[out_i, 23] = 1.0 if stuck else 0.0
+                out[out_i, 24] = 1.0 if heat_u else 0.0
+                out[out_i, 25] = 1.0 if heat_l else 0.0
                 out_i += 1
                 next_out += out_ticks
             if b > a:
-                integrate_rest(method, y, (b - a) * tick_s, d, p, work, aux)
+                yt = integrate_rest(method, yt, (b - a) * tick_s, dv, pt, k1, kin)
+                for i in range(N_STATE):
+                    y[i] = yt[i]
                 counters[C_EVALS] += 3 if method == 1 else 0
                 counters[C_SUBSTEPS] += 1
             if p[P_stress_algebraic] == 0.0:
@@ -350,8 +376,6 @@ def run_kernel(p, seg_start, seg_target, seg_enable, strategy, wait_release,
                     for q in range(N_STATE):
                         err_state[1 + q] = y[q]
                     return
-            xi_u, sig_u = _wire_xi_sigma(y, d, p, True)
-            xi_l, sig_l = _wire_xi_sigma(y, d, p, False)
             a = b
         if t >= t_end_ticks:
             break

@@ -19,7 +19,7 @@ from .rhs import N_STATE
 
 TICK_S = 1e-9
 DEFAULT_DT_S = 1e-3
-#: classical RK4. Forward Euler at 1 ms is 2.4x faster on the co-operative full cycle and
+#: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
 #: 0.01 deg RMS from a 1 us reference there (benchmarks/bench_core.py), but it blows up on
 #: the open-loop Table II runs of Figs. 7-8 (a stiff joint-tendon mode): not a safe default.
 DEFAULT_METHOD = "rk4"
