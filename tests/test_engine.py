@@ -118,3 +118,17 @@ def test_reached_metric_agrees_with_reach_trigger():
     from smafinger.results import time_to_reach
     alt = time_to_reach(r.t, r.theta_deg, -25.0, 0.0, s1["start_s"] + 1e-3, 0.5, 0.5 - 1e-3)
     assert alt == pytest.approx(s0["reached_s"], abs=2e-3)
+
+
+def test_long_pwm_voltage_program_matches_item_by_item_parse():
+    from smafinger.engine.run import ticks_array, to_ticks
+    from smafinger.profiles import VoltageProgram
+
+    items = [(k * 1e-3, 8.0, 0.0) for k in range(4000)] + [(4.0, 0.0, 2.5)]
+    text = ",".join(f"{t!r}:{u!r}:{v!r}" for t, u, v in items)
+    prog = VoltageProgram.parse(text)
+    assert prog.steps == tuple(items)
+    starts = prog.arrays()[0]
+    assert ticks_array("voltage start", starts).tolist() == [to_ticks("t", t, True) for t in starts]
+    with pytest.raises(ValueError, match=r"voltage start \[1\] = 1e-10 s is not a whole number"):
+        ticks_array("voltage start", np.array([0.0, 1e-10]))

@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from .control.strategies import ENABLES
 
 
@@ -75,29 +77,49 @@ class VoltageProgram:
             raise ProfileError("voltage program: at least one step is needed")
         if self.steps[0][0] != 0.0:
             raise ProfileError(f"voltage program: the first step must start at 0 s, not {self.steps[0][0]}")
-        last = -math.inf
-        for i, (t, vu, vl) in enumerate(self.steps):
-            if not math.isfinite(t) or t <= last:
-                raise ProfileError(f"voltage program step {i}: start {t} s must be after the previous one")
-            last = t
-            for name, v in (("V_upper", vu), ("V_lower", vl)):
-                if not math.isfinite(v) or not 0.0 <= v <= 100.0:
-                    raise ProfileError(f"voltage program step {i}: {name} = {v} V is outside [0, 100]")
-            if vu > 0 and vl > 0:
-                raise ProfileError(
-                    f"voltage program step {i} (t = {t} s): both wires heated at once "
-                    f"({vu} V, {vl} V) would break the interlock"
-                )
+        # vectorised check of the whole program (a PWM program has thousands of steps);
+        # the first bad step found in order gets the message
+        a = np.asarray(self.steps, dtype=float).reshape(-1, 3)
+        t, vu, vl = a[:, 0], a[:, 1], a[:, 2]
+        bad_t = ~np.isfinite(t)
+        bad_t[1:] |= ~(t[1:] > t[:-1])
+        bad_v = ~(np.isfinite(vu) & (vu >= 0.0) & (vu <= 100.0) & np.isfinite(vl) & (vl >= 0.0) & (vl <= 100.0))
+        both = (vu > 0) & (vl > 0)
+        if not (bad_t.any() or bad_v.any() or both.any()):
+            return
+        i = int(np.flatnonzero(bad_t | bad_v | both)[0])
+        if bad_t[i]:
+            raise ProfileError(f"voltage program step {i}: start {t[i]} s must be after the previous one")
+        for name, v in (("V_upper", vu[i]), ("V_lower", vl[i])):
+            if not math.isfinite(v) or not 0.0 <= v <= 100.0:
+                raise ProfileError(f"voltage program step {i}: {name} = {v} V is outside [0, 100]")
+        raise ProfileError(
+            f"voltage program step {i} (t = {t[i]} s): both wires heated at once "
+            f"({vu[i]} V, {vl[i]} V) would break the interlock"
+        )
 
     @classmethod
     def parse(cls, text: str) -> "VoltageProgram":
+        items = [p for p in text.split(",") if p.strip()]
+        try:  # fast path: every item is T:V_UPPER:V_LOWER with plain numbers
+            flat = np.array(":".join(items).split(":"), dtype=float)
+            if (flat.size == 3 * len(items) and np.isfinite(flat).all()
+                    and all(item.count(":") == 2 for item in items)):
+                return cls(tuple(map(tuple, flat.reshape(-1, 3).tolist())))
+        except ValueError:
+            pass
         steps = []
-        for i, item in enumerate(p for p in text.split(",") if p.strip()):
+        for i, item in enumerate(items):
             parts = item.split(":")
             if len(parts) != 3:
                 raise ProfileError(f"voltage item {i} {item!r}: expected T:V_UPPER:V_LOWER")
             steps.append(tuple(_float(x, f"voltage item {i}") for x in parts))
         return cls(tuple(steps))
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(start_s, V_upper, V_lower) as float arrays."""
+        a = np.asarray(self.steps, dtype=float).reshape(-1, 3)
+        return a[:, 0].copy(), a[:, 1].copy(), a[:, 2].copy()
 
 
 def _float(text: str, what: str) -> float:

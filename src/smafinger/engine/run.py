@@ -44,6 +44,19 @@ def to_ticks(name: str, value_s: float, allow_zero: bool = False) -> int:
     return int(ticks)
 
 
+def ticks_array(name: str, values_s: np.ndarray) -> np.ndarray:
+    """:func:`to_ticks` (zero allowed) of many times at once; the first bad one is named."""
+    v = np.asarray(values_s, dtype=float)
+    ticks = np.rint(v / TICK_S)
+    err = np.abs(ticks * TICK_S - v)
+    ok = (np.isfinite(v) & (v >= 0)
+          & ((err <= 1e-6 * TICK_S * np.maximum(1.0, ticks)) | (err <= 1e-12)))
+    if not ok.all():
+        i = int(np.flatnonzero(~ok)[0])
+        to_ticks(f"{name} [{i}]", float(v[i]), allow_zero=True)  # raises with the reason
+    return ticks.astype(np.int64)
+
+
 @dataclass(frozen=True)
 class RunSpec:
     """Everything one run needs, validated and in kernel form."""
@@ -105,9 +118,8 @@ def kernel_args(spec: RunSpec) -> dict:
     seg_target = np.array([math.radians(s.target_deg) for s in segs])
     seg_enable = np.array([ENABLES[s.enable] for s in segs], dtype=np.int64)
     if spec.voltage is not None:
-        vt = np.array([to_ticks("voltage start", s[0], True) for s in spec.voltage.steps], dtype=np.int64)
-        vu = np.array([s[1] for s in spec.voltage.steps])
-        vl = np.array([s[2] for s in spec.voltage.steps])
+        vs, vu, vl = spec.voltage.arrays()
+        vt = ticks_array("voltage start", vs)
     else:
         vt = np.zeros(0, dtype=np.int64)
         vu = np.zeros(0)
