@@ -139,8 +139,13 @@ def chunked(tasks: Sequence[Task], size: int) -> list[list[Task]]:
     return [list(tasks[i:i + size]) for i in range(0, len(tasks), size)]
 
 
-def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 4, lo: int = 1, hi: int = 64) -> int:
-    """Runs per task: about ``per_slot`` tasks per worker slot, within [lo, hi]."""
+def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 16, lo: int = 1, hi: int = 64) -> int:
+    """Runs per task: about ``per_slot`` tasks per worker slot, within [lo, hi].
+
+    Many small tasks balance the end of a batch: with a run at about 7 ms, 16 tasks per
+    slot keep a task near 50 ms (scheduling costs well under 1 ms locally and a few ms on
+    Dask) while the last task leaves a worker idle for only that long.
+    """
     if n_tasks <= 0:
         return 1
     return max(lo, min(hi, math.ceil(n_tasks / (max(1, slots) * per_slot))))
