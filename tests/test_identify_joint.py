@@ -1,7 +1,6 @@
 """Joint-level fit (Fig. 9): recovery of h0, h2, C_DF from synthetic curves, nonsmoothness."""
 
 import json
-import time
 
 import numpy as np
 import pytest
@@ -52,20 +51,18 @@ def joint_run(tmp_path_factory):
     cool_b = write_csv(d / "cool_10s.csv", synthesize(TRUTH, "0:8:0,10:0:0", 22.0, SAMPLE_S, NOISE_DEG, seed=13),
                        voltage=False)
     out, rep, png = d / "fit.toml", d / "fit.json", d / "fit.png"
-    t0 = time.perf_counter()
     # start far away: Table II's h0 = 70, h2 = 1e-3, C_DF = 0.02 for both phases
     r = CliRunner().invoke(app, ["joint", "--heating", str(heat), "--cooling", str(cool_a), "--cooling", str(cool_b),
                                  "--heat-s", "3.5", "--heat-s", "10", "--cooling-voltage", "8",
                                  "--params", "paper2010-table2", "--out", str(out), "--report", str(rep),
                                  "--plot", str(png), "--no-progress"])
-    wall = time.perf_counter() - t0
     assert r.exit_code == 0, r.stderr
-    return r, wall, out, json.loads(rep.read_text()), png
+    return r, out, json.loads(rep.read_text()), png
 
 
-def test_joint_fit_recovers_h0_h2_cdf_within_5_percent_in_under_60_s(joint_run):
-    r, wall, out, rep, png = joint_run
-    assert wall < 60.0
+def test_joint_fit_recovers_h0_h2_cdf_within_5_percent(joint_run):
+    """The same fit is timed by benchmarks/bench_identify.py (issue 4: under 60 s)."""
+    r, out, rep, png = joint_run
     fields = PHASE_FIELDS["heating"] + PHASE_FIELDS["cooling"]
     for k in fields:
         assert rep["values"][k] == pytest.approx(getattr(TRUTH, k), rel=0.05), k
@@ -80,7 +77,7 @@ def test_joint_fit_recovers_h0_h2_cdf_within_5_percent_in_under_60_s(joint_run):
 
 
 def test_joint_fit_toml_is_accepted_by_simulate(joint_run):
-    _, _, out, rep, _ = joint_run
+    _, out, rep, _ = joint_run
     assert 'base = "paper2010-table2"' in out.read_text()
     p = resolve(str(out))
     for k, v in rep["values"].items():
