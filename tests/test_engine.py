@@ -7,9 +7,10 @@ import pytest
 
 from smafinger import SimulationError, simulate
 from smafinger.engine import integrators
-from smafinger.engine.kernel import C_VIOLATIONS, N_COUNTERS, N_OUT, run_kernel
+from smafinger.engine.kernel import run_kernel
 from smafinger.engine.run import kernel_args, make_spec
-from smafinger.engine.rhs import N_STATE
+from smafinger.engine.signals import new_outputs
+from smafinger.model.build import build_model
 from smafinger.model.kinetics import g_heating
 from smafinger.parameters import get
 
@@ -22,15 +23,15 @@ def smooth_case():
     """
     p = get("paper2010-table2").replace(M_SF_Nm=0.0, friction_sticking="initial-only",
                                         T_amb_C=80.0, T_init_C=80.0, minor_loop_reversal_C=0.0)
-    from smafinger.model.layout import IDX, pack
-    sigma0 = pack(p)[IDX["sigma0_u"]]
+    sigma0 = build_model(p).wires[0].sigma0_Pa
     xi0 = g_heating(80.0, sigma0, p.A_S0_C, p.A_F0_C, p.c_A_Pa_per_C)[0]
     return p.replace(xi_init=float(xi0))
 
 
 def final_state(p, method, dt):
     r = simulate(p, "open-loop", voltage="0:8:0", t_end_s=0.4, dt_s=dt, method=method, output_interval_s=0.4)
-    return np.array([r.raw("theta")[-1], r.raw("T_u")[-1], r.raw("sigma_u")[-1], r.raw("omega")[-1]])
+    return np.array([math.radians(r.theta_deg[-1]), r.T_upper_C[-1], r.sigma_upper_Pa[-1],
+                     math.radians(r.omega_deg_s[-1])])
 
 
 @pytest.mark.parametrize("name", ["euler", "rk4"])
@@ -54,7 +55,7 @@ def test_motion_happens_in_smooth_case():
 def test_determinism_bit_identical():
     a = simulate("paper2010", "cooperative", "0:-25,reach:-55,reach:-40", t_end_s=30)
     b = simulate("paper2010", "cooperative", "0:-25,reach:-55,reach:-40", t_end_s=30)
-    assert a.data.tobytes() == b.data.tobytes()
+    assert a.mechanism.tobytes() == b.mechanism.tobytes() and a.wires.tobytes() == b.wires.tobytes()
     assert a.substeps == b.substeps
 
 
@@ -64,7 +65,7 @@ def test_pwm_edges_resolved_whatever_the_step():
     energies = []
     for dt in (1e-3, 3e-4, 7e-5):
         r = simulate(p, "independent", "0:-38", t_end_s=0.05, dt_s=dt, output_interval_s=1e-3)
-        energies.append(r.raw("E_u")[-1])
+        energies.append(r.energy_upper_J[-1])
     # same duty sequence (updated on integer ticks) -> same on-time within the rounding of h
     assert max(energies) - min(energies) < 1e-3 * max(energies)
 
@@ -84,13 +85,13 @@ def test_blow_up_reports_time_and_state():
 def test_interlock_counter_counts_a_forced_violation():
     spec = make_spec("paper2010", "open-loop", voltage="0:8:0", t_end_s=0.1)
     args = kernel_args(spec)
-    args["volt_u"] = np.array([8.0])
-    args["volt_l"] = np.array([8.0])  # bypasses the program validation on purpose
-    out = np.full((args["t_end_ticks"] // args["out_ticks"] + 1, N_OUT), np.nan)
-    counters = np.zeros(N_COUNTERS + 1, dtype=np.int64)
-    run_kernel(out=out, seg_actual=np.zeros(1, dtype=np.int64), seg_reached=np.zeros(1, dtype=np.int64), counters=counters,
-               err_state=np.zeros(1 + N_STATE), **args)
-    assert counters[C_VIOLATIONS] == 100
+    prog = args["prog"]
+    forced = prog._replace(level=np.array([[8.0, 8.0]]), duty=np.array([[100.0, 100.0]]))  # bypasses the check
+    run = args["run"]
+    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, 2)
+    counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
+                                np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+    assert counters.violations == 100
 
 
 @pytest.mark.parametrize("strategy", ["independent", "cooperative"])
@@ -105,7 +106,7 @@ def test_interlock_never_violated_in_closed_loop(strategy):
 @pytest.mark.parametrize("dt", [2e-3, 5e-4])
 def test_output_grid_independent_of_step(dt):
     r = simulate("paper2010", "cooperative", "0:-25", t_end_s=3, dt_s=dt, output_interval_s=1e-3)
-    assert not np.isnan(r.data).any() and len(r.t) == 3001
+    assert not np.isnan(r.to_pandas().to_numpy()).any() and len(r.t) == 3001
 
 
 def test_reached_metric_agrees_with_reach_trigger():

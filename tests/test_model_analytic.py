@@ -9,9 +9,15 @@ from hypothesis import strategies as st
 
 from smafinger import simulate
 from smafinger.model import heat, kinetics
-from smafinger.model.kinematics import both_tendons
-from smafinger.model.layout import IDX, pack
+from smafinger.model.build import build_model
+from smafinger.model.kinematics import wire_route
 from smafinger.parameters import get
+
+
+def both_tendons(model, theta):
+    """(path_U, dpath_U, arm_U, path_L, dpath_L, arm_L) of the joint's two tendons."""
+    up, lo = (wire_route(w.route, theta) for w in model.wires)
+    return (*up, *lo)
 
 
 def wire_constants(p):
@@ -25,7 +31,7 @@ def test_eq11_constant_h_matches_closed_form():
     p = get("paper2010").replace(h0_heating_W_m2K=h, h2_heating_W_m2K3=0.0, h0_cooling_W_m2K=h,
                                  h2_cooling_W_m2K3=0.0)
     S_w, M_w, A_w = wire_constants(p)
-    T_ss = heat.steady_state_temperature(8.0, h, p.T_amb_C, p.resistance_ohm_per_m, A_w)
+    T_ss = heat.steady_state_temperature(8.0**2 / p.resistance_ohm_per_m, h, p.T_amb_C, A_w)
     tau = heat.time_constant(h, M_w, p.specific_heat_J_kgK, A_w)
     # independent hand numbers: 64/8.6 W/m over h pi d; tau = rho S C_p / (h pi d)
     assert T_ss == pytest.approx(23 + (64 / 8.6) / (h * math.pi * 0.375e-3), rel=1e-12)
@@ -46,7 +52,7 @@ def test_eq11_constant_h_matches_closed_form():
 def test_heating_rate_about_30_C_per_s():
     p = get("paper2010")
     S_w, M_w, A_w = wire_constants(p)
-    rate = heat.temperature_rate(23.0, 8.0, 20.0, 5e-4, 23.0, 8.6, M_w, 322.0, A_w)
+    rate = heat.heat_balance(23.0, 8.0**2 / 8.6, heat.convection_coefficient(23.0, 20.0, 5e-4), 23.0, M_w, 322.0, A_w)
     assert 28 < rate < 35  # MODEL-NOTES: roughly 30 degC/s from 8 V
 
 
@@ -118,7 +124,7 @@ def hand_arm(B, P):
 
 def test_moment_arms_and_paths_at_minus_40_deg():
     p = get("paper2010")
-    v = pack(p)
+    model = build_model(p)
     th = math.radians(-40.0)
     # by hand (mm): r = sqrt(12.3^2 + 14.5^2) = 19.0142; B_U at angle atan(12.3/14.5) - 40 = 0.3071 deg
     r = math.sqrt(12.3**2 + 14.5**2)
@@ -132,8 +138,7 @@ def test_moment_arms_and_paths_at_minus_40_deg():
     arm_l = hand_arm(BL, (-17.5, -12.3))
     assert arm_u == pytest.approx(13.3449, abs=1e-3)
     assert arm_l == pytest.approx(16.9448, abs=1e-3)
-    pu, du, bu, pl, dl, bl = both_tendons(th, v[IDX["r"]], v[IDX["a0_u"]], v[IDX["a0_l"]],
-                                          v[IDX["a1"]], v[IDX["a2"]], v[IDX["a4"]], v[IDX["a5"]])
+    pu, du, bu, pl, dl, bl = both_tendons(model, th)
     assert 1e3 * pu == pytest.approx(path_u, abs=1e-6)
     assert 1e3 * pl == pytest.approx(path_l, abs=1e-6)
     assert 1e3 * bu == pytest.approx(arm_u, abs=1e-6)
@@ -142,31 +147,28 @@ def test_moment_arms_and_paths_at_minus_40_deg():
     assert du == pytest.approx(-bu, rel=1e-12)
     assert dl == pytest.approx(bl, rel=1e-12)
     h = 1e-6
-    f = lambda t: both_tendons(t, v[IDX["r"]], v[IDX["a0_u"]], v[IDX["a0_l"]], v[IDX["a1"]],  # noqa: E731
-                               v[IDX["a2"]], v[IDX["a4"]], v[IDX["a5"]])
+    f = lambda t: both_tendons(model, t)  # noqa: E731
     assert (f(th + h)[0] - f(th - h)[0]) / (2 * h) == pytest.approx(du, rel=1e-6)
 
 
 def test_path_continuous_at_configuration_switch():
-    v = pack(get("paper2010"))
-    args = (v[IDX["r"]], v[IDX["a0_u"]], v[IDX["a0_l"]], v[IDX["a1"]], v[IDX["a2"]], v[IDX["a4"]], v[IDX["a5"]])
+    model = build_model(get("paper2010"))
     # the switch is where Y of B_U = a1, i.e. theta = 0 with this geometry
-    lo, hi = both_tendons(-1e-9, *args), both_tendons(1e-9, *args)
+    lo, hi = both_tendons(model, -1e-9), both_tendons(model, 1e-9)
     assert abs(lo[0] - hi[0]) < 1e-10 and abs(lo[3] - hi[3]) < 1e-10
     assert abs(lo[2] - hi[2]) < 1e-8 and abs(lo[5] - hi[5]) < 1e-8
 
 
 def test_authors2020_start_is_static_equilibrium():
     p = get("authors2020")
-    v = pack(p)
+    upper, lower = build_model(p).wires
     th = math.radians(p.theta0_deg)
-    _, _, bu, _, _, bl = both_tendons(th, v[IDX["r"]], v[IDX["a0_u"]], v[IDX["a0_l"]], v[IDX["a1"]],
-                                      v[IDX["a2"]], v[IDX["a4"]], v[IDX["a5"]])
-    S_w = v[IDX["S_w"]]
-    M_E = v[IDX["sigma0_u"]] * S_w * bu - v[IDX["sigma0_l"]] * S_w * bl - p.mass_kg * 9.81 * p.d_CM_m * math.cos(th)
+    _, _, bu, _, _, bl = both_tendons(build_model(p), th)
+    S_w = upper.area_m2
+    M_E = upper.sigma0_Pa * S_w * bu - lower.sigma0_Pa * S_w * bl - p.mass_kg * 9.81 * p.d_CM_m * math.cos(th)
     assert abs(M_E) < 1e-12
     # the lower spring is held at its given length (15.48 mm)
-    assert v[IDX["x0_l"]] == pytest.approx(15.48e-3 - 9.17e-3, abs=1e-15)
+    assert lower.series_x0_m == pytest.approx(15.48e-3 - 9.17e-3, abs=1e-15)
     # left alone, the joint stays exactly where it started
     r = simulate(p, "independent", "0:-40:none", t_end_s=2.0)
     assert np.all(r.theta_deg == pytest.approx(-40.0, abs=1e-9))
@@ -178,4 +180,4 @@ def test_paper_spring_lengths_start_held_by_stiction():
     p = get("paper2010").replace(spring_init="given")
     r = simulate(p, "independent", "0:-40:none", t_end_s=1.0)
     assert np.all(r.theta_deg == -40.0)
-    assert r.raw("stuck")[0] == 1.0
+    assert r.stuck[0] == 1.0

@@ -1,10 +1,14 @@
-"""Figures laid out like the paper's (angle, velocity, temperatures, voltages, deformations)."""
+"""Figures laid out like the paper's (position, velocity, temperatures, voltages, deformations).
+
+The same five panels for any mechanism: the joint's angle in degrees, a slider's position in
+millimetres.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
+from .files import atomic_write
 
 
 def _mpl():
@@ -16,49 +20,50 @@ def _mpl():
     return plt
 
 
+#: mechanism -> (coordinate column, its reference, velocity column, axis scale, axis labels)
+_AXES = {
+    "joint": ("theta_deg", "theta_ref_deg", "omega_deg_s", 1.0, r"$\theta$", "Joint angle [deg]",
+              "Angular velocity [deg/s]"),
+    "linear-bias-spring": ("position_m", "position_ref_m", "velocity_m_s", 1e3, "x", "Position [mm]",
+                           "Velocity [mm/s]"),
+}
+_COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
+
+
 def plot_result(result, path: str | Path | None = None, title: str | None = None):
     """Five stacked panels sharing the time axis; saved to ``path`` if given."""
     plt = _mpl()
+    p = result.spec.params
+    q, q_ref, v, k, sym, q_label, v_label = _AXES[p.mechanism]
     t = result.t
     fig, ax = plt.subplots(5, 1, figsize=(7.5, 10.5), sharex=True, constrained_layout=True)
-    ax[0].plot(t, result.theta_deg, color="k", label=r"$\theta$")
-    ax[0].plot(t, result.theta_ref_deg, color="tab:red", ls="--", lw=1.0, label=r"$\theta_F$ (target)")
-    ax[0].set_ylabel("Joint angle [deg]")
+    ax[0].plot(t, k * result.signal(q), color="k", label=sym)
+    ax[0].plot(t, k * result.signal(q_ref), color="tab:red", ls="--", lw=1.0, label="target")
+    ax[0].set_ylabel(q_label)
     ax[0].legend(loc="best", fontsize=8)
-    ax[1].plot(t, result.omega_deg_s, color="k")
-    ax[1].set_ylabel("Angular velocity [deg/s]")
-    ax[2].plot(t, result.T_upper_C, color="tab:blue", label="upper")
-    ax[2].plot(t, result.T_lower_C, color="tab:orange", label="lower")
+    ax[1].plot(t, k * result.signal(v), color="k")
+    ax[1].set_ylabel(v_label)
+    open_loop = result.spec.strategy == "open-loop"
+    for i, w in enumerate(p.wire_names):
+        c = _COLORS[i % len(_COLORS)]
+        ax[2].plot(t, result.signal(f"T_{w}_C"), color=c, label=w)
+        # PWM voltage sampled every output interval is unreadable at 1 ms; show V_H x duty
+        drive = result.signal(f"V_{w}_V") if open_loop else p.V_H_V * result.signal(f"duty_{w}") / 100.0
+        ax[3].plot(t, drive, color=c, lw=0.8, label=w)
+        contraction = 1e3 * p.wire_length_m * p.eps_R * (p.xi_init - result.signal(f"xi_{w}"))
+        ax[4].plot(t, contraction, color=c, ls=":", label=f"{w} wire contraction")
+        if p.mechanism == "joint":
+            ax[4].plot(t, 1e3 * result.signal(f"spring_{w}_m"), color=c, label=f"{w} spring")
     ax[2].set_ylabel("Wire temperature [°C]")
-    ax[2].legend(loc="best", fontsize=8)
-    # PWM voltage averaged over each output interval is unreadable at 1 ms; show V_H x duty
-    vh = result.spec.params.V_H_V
-    if result.spec.strategy == "open-loop":
-        vu, vl = result.V_upper_V, result.V_lower_V
-        lab = "voltage [V]"
-    else:
-        vu, vl = vh * result.duty_upper / 100.0, vh * result.duty_lower / 100.0
-        lab = r"Mean voltage $V_H\,DC\%$ [V]"
-    ax[3].plot(t, vu, color="tab:blue", lw=0.8, label="upper")
-    ax[3].plot(t, vl, color="tab:orange", lw=0.8, label="lower")
-    ax[3].set_ylabel(lab)
-    ax[3].legend(loc="best", fontsize=8)
-    L = result.spec.params.wire_length_m
-    eps_R = result.spec.params.eps_R
-    xi0 = result.spec.params.xi_init
-    ax[4].plot(t, 1e3 * result.spring_upper_m, color="tab:blue", label="upper spring")
-    ax[4].plot(t, 1e3 * result.spring_lower_m, color="tab:orange", label="lower spring")
-    ax[4].plot(t, 1e3 * L * eps_R * (xi0 - result.xi_upper), color="tab:blue", ls=":", label="upper wire contraction")
-    ax[4].plot(t, 1e3 * L * eps_R * (xi0 - result.xi_lower), color="tab:orange", ls=":", label="lower wire contraction")
+    ax[3].set_ylabel("Drive [V]" if open_loop else r"Mean voltage $V_H\,DC\%$ [V]")
     ax[4].set_ylabel("Deformation [mm]")
     ax[4].set_xlabel("Time [s]")
-    ax[4].legend(loc="best", fontsize=7, ncol=2)
+    for a in ax[2:]:
+        a.legend(loc="best", fontsize=7, ncol=2)
     for a in ax:
         a.grid(True, alpha=0.3)
-    fig.suptitle(title or f"{result.spec.params.name}, {result.spec.strategy}")
+    fig.suptitle(title or f"{p.name}, {result.spec.strategy}")
     if path is not None:
-        from .results import atomic_write
-
         suffix = Path(path).suffix.lstrip(".") or "png"
         atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=130, format=suffix))
         plt.close(fig)

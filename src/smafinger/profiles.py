@@ -1,11 +1,15 @@
-"""Target profiles (closed loop) and voltage programs (open loop).
+"""Target profiles (closed loop) and drive programs (open loop).
 
-A target profile is a piecewise schedule of segments ``(start, target angle, enable)``;
-``enable`` is one of auto, upper, lower, both, none. A segment's start may be ``None``
-("reach"): it then begins as soon as the previous target is reached (within the tolerance,
-for the hold time). Text form, as on the CLI: ``"0:-25,10:-40:none,reach:-55:both"``.
+A target profile is a piecewise schedule of segments ``(start, target, enable)``. The target is
+in the mechanism's user unit (degrees for the joint, metres for the linear actuator); ``enable``
+is auto, none, both (all), or a wire's name (upper, lower; wire). A segment's start may be
+``None`` ("reach"): it then begins as soon as the previous target is reached (within the
+tolerance, for the hold time). Text form, as on the CLI: ``"0:-25,10:-40:none,reach:-55:both"``.
+Targets and enable words are checked against the mechanism when the run is built.
 
-A voltage program is a piecewise-constant voltage per wire: ``"0:8:0,6:0:0"``.
+A drive program is a piecewise-constant drive per wire: voltages ``"0:8:0,6:0:0"`` (one column
+per wire: upper, lower), duties as fractions of the supply V_H (``kind="duty"``, for example
+``"0:0.2,5:0"``), or currents in amperes (``kind="current"``).
 """
 
 from __future__ import annotations
@@ -15,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .control.strategies import ENABLES
 
 
 class ProfileError(ValueError):
@@ -25,8 +28,13 @@ class ProfileError(ValueError):
 @dataclass(frozen=True)
 class Segment:
     start_s: float | None
-    target_deg: float
+    target: float  #: in the mechanism's user unit (deg for the joint, m for the linear actuator)
     enable: str = "auto"
+
+    @property
+    def target_deg(self) -> float:
+        """The joint's target angle (the target, read as degrees)."""
+        return self.target
 
 
 @dataclass(frozen=True)
@@ -40,10 +48,10 @@ class TargetProfile:
             raise ProfileError(f"profile: the first segment must start at 0 s, not {self.segments[0].start_s}")
         last = -math.inf
         for i, s in enumerate(self.segments):
-            if s.enable not in ENABLES:
-                raise ProfileError(f"profile segment {i}: enable {s.enable!r} is not one of {', '.join(ENABLES)}")
-            if not math.isfinite(s.target_deg) or not -89.0 <= s.target_deg <= 89.0:
-                raise ProfileError(f"profile segment {i}: target {s.target_deg} deg is outside [-89, 89]")
+            if not s.enable.replace("-", "").isalnum():
+                raise ProfileError(f"profile segment {i}: enable {s.enable!r} is not a word")
+            if not math.isfinite(s.target):
+                raise ProfileError(f"profile segment {i}: target {s.target} is not finite")
             if s.start_s is not None:
                 if not math.isfinite(s.start_s) or s.start_s < 0 or s.start_s <= last:
                     raise ProfileError(f"profile segment {i}: start {s.start_s} s must be finite and after the previous one ({last} s)")
@@ -61,65 +69,89 @@ class TargetProfile:
         return cls(tuple(segs))
 
     @classmethod
-    def constant(cls, target_deg: float, enable: str = "auto") -> "TargetProfile":
-        return cls((Segment(0.0, target_deg, enable),))
+    def constant(cls, target: float, enable: str = "auto") -> "TargetProfile":
+        return cls((Segment(0.0, target, enable),))
 
     def to_text(self) -> str:
-        return ",".join(f"{'reach' if s.start_s is None else repr(s.start_s)}:{s.target_deg!r}:{s.enable}" for s in self.segments)
+        return ",".join(f"{'reach' if s.start_s is None else repr(s.start_s)}:{s.target!r}:{s.enable}" for s in self.segments)
+
+
+#: drive program kinds: (unit, largest value)
+DRIVE_KINDS = {"voltage": ("V", 100.0), "duty": ("fraction of V_H", 1.0), "current": ("A", 20.0)}
 
 
 @dataclass(frozen=True)
 class VoltageProgram:
-    steps: tuple[tuple[float, float, float], ...]  # (start_s, V_upper, V_lower)
+    """A piecewise-constant drive per wire: steps ``(start_s, value_1, ..., value_n)``.
+
+    ``kind``: ``voltage`` [V] (the default), ``duty`` (a fraction of the supply V_H, switched at
+    the PWM period) or ``current`` [A]. Each step has one value per wire of the mechanism.
+    """
+
+    steps: tuple[tuple[float, ...], ...]
+    kind: str = "voltage"
 
     def __post_init__(self) -> None:
+        if self.kind not in DRIVE_KINDS:
+            raise ProfileError(f"drive program kind {self.kind!r} is not one of {', '.join(DRIVE_KINDS)}")
         if not self.steps:
-            raise ProfileError("voltage program: at least one step is needed")
+            raise ProfileError("drive program: at least one step is needed")
+        widths = {len(st) for st in self.steps}
+        if len(widths) != 1 or min(widths) < 2:
+            raise ProfileError("drive program: every step needs a time and the same number of values (one per wire)")
         if self.steps[0][0] != 0.0:
-            raise ProfileError(f"voltage program: the first step must start at 0 s, not {self.steps[0][0]}")
+            raise ProfileError(f"drive program: the first step must start at 0 s, not {self.steps[0][0]}")
         # vectorised check of the whole program (a PWM program has thousands of steps);
         # the first bad step found in order gets the message
-        a = np.asarray(self.steps, dtype=float).reshape(-1, 3)
-        t, vu, vl = a[:, 0], a[:, 1], a[:, 2]
+        a = np.asarray(self.steps, dtype=float)
+        t, v = a[:, 0], a[:, 1:]
+        unit, top = DRIVE_KINDS[self.kind]
         bad_t = ~np.isfinite(t)
         bad_t[1:] |= ~(t[1:] > t[:-1])
-        bad_v = ~(np.isfinite(vu) & (vu >= 0.0) & (vu <= 100.0) & np.isfinite(vl) & (vl >= 0.0) & (vl <= 100.0))
-        both = (vu > 0) & (vl > 0)
-        if not (bad_t.any() or bad_v.any() or both.any()):
+        bad_v = ~(np.isfinite(v) & (v >= 0.0) & (v <= top)).all(axis=1)
+        if not (bad_t.any() or bad_v.any()):
             return
-        i = int(np.flatnonzero(bad_t | bad_v | both)[0])
+        i = int(np.flatnonzero(bad_t | bad_v)[0])
         if bad_t[i]:
-            raise ProfileError(f"voltage program step {i}: start {t[i]} s must be after the previous one")
-        for name, v in (("V_upper", vu[i]), ("V_lower", vl[i])):
-            if not math.isfinite(v) or not 0.0 <= v <= 100.0:
-                raise ProfileError(f"voltage program step {i}: {name} = {v} V is outside [0, 100]")
-        raise ProfileError(
-            f"voltage program step {i} (t = {t[i]} s): both wires heated at once "
-            f"({vu[i]} V, {vl[i]} V) would break the interlock"
-        )
+            raise ProfileError(f"drive program step {i}: start {t[i]} s must be finite and after the previous one")
+        k = int(np.flatnonzero(~(np.isfinite(v[i]) & (v[i] >= 0.0) & (v[i] <= top)))[0])
+        raise ProfileError(f"drive program step {i}: value {k + 1} = {v[i, k]} {unit} is outside [0, {top:g}]")
+
+    @property
+    def n_wires(self) -> int:
+        return len(self.steps[0]) - 1
 
     @classmethod
-    def parse(cls, text: str) -> "VoltageProgram":
+    def parse(cls, text: str, kind: str = "voltage") -> "VoltageProgram":
+        """``"T:V_1[:V_2...],..."``: a time and one value per wire."""
         items = [p for p in text.split(",") if p.strip()]
-        try:  # fast path: every item is T:V_UPPER:V_LOWER with plain numbers
+        if not items:
+            raise ProfileError(f"{kind} program {text!r}: no steps")
+        width = items[0].count(":") + 1
+        try:  # fast path: every item is T:V...:V with plain numbers
             flat = np.array(":".join(items).split(":"), dtype=float)
-            if (flat.size == 3 * len(items) and np.isfinite(flat).all()
-                    and all(item.count(":") == 2 for item in items)):
-                return cls(tuple(map(tuple, flat.reshape(-1, 3).tolist())))
+            if (flat.size == width * len(items) and np.isfinite(flat).all()
+                    and all(item.count(":") == width - 1 for item in items)):
+                return cls(tuple(map(tuple, flat.reshape(-1, width).tolist())), kind)
         except ValueError:
             pass
         steps = []
         for i, item in enumerate(items):
             parts = item.split(":")
-            if len(parts) != 3:
-                raise ProfileError(f"voltage item {i} {item!r}: expected T:V_UPPER:V_LOWER")
-            steps.append(tuple(_float(x, f"voltage item {i}") for x in parts))
-        return cls(tuple(steps))
+            if len(parts) != width or width < 2:
+                raise ProfileError(f"{kind} item {i} {item!r}: expected T:VALUE[:VALUE...] with "
+                                   f"{max(width - 1, 1)} value(s), as the first item")
+            steps.append(tuple(_float(x, f"{kind} item {i}") for x in parts))
+        return cls(tuple(steps), kind)
 
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(start_s, V_upper, V_lower) as float arrays."""
-        a = np.asarray(self.steps, dtype=float).reshape(-1, 3)
-        return a[:, 0].copy(), a[:, 1].copy(), a[:, 2].copy()
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        """(start_s, values of wire 1, ..., values of wire n) as float arrays."""
+        a = np.asarray(self.steps, dtype=float)
+        return tuple(a[:, k].copy() for k in range(a.shape[1]))
+
+
+#: the open-loop program of any drive kind
+DriveProgram = VoltageProgram
 
 
 def _float(text: str, what: str) -> float:

@@ -2,72 +2,31 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
-import os
-import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .engine.kernel import OUT_COLUMNS
-
-#: exported column -> (kernel column, scale)
-EXPORT_COLUMNS: dict[str, tuple[str, float]] = {
-    "t_s": ("t", 1.0),
-    "theta_deg": ("theta", 180.0 / math.pi),
-    "theta_ref_deg": ("theta_ref", 180.0 / math.pi),
-    "omega_deg_s": ("omega", 180.0 / math.pi),
-    "T_upper_C": ("T_u", 1.0),
-    "T_lower_C": ("T_l", 1.0),
-    "xi_upper": ("xi_u", 1.0),
-    "xi_lower": ("xi_l", 1.0),
-    "sigma_upper_Pa": ("sigma_u", 1.0),
-    "sigma_lower_Pa": ("sigma_l", 1.0),
-    "force_upper_N": ("sigma_u", None),  # sigma * S_w
-    "force_lower_N": ("sigma_l", None),
-    "arm_upper_m": ("arm_u", 1.0),
-    "arm_lower_m": ("arm_l", 1.0),
-    "spring_upper_m": ("spring_u", 1.0),
-    "spring_lower_m": ("spring_l", 1.0),
-    "V_upper_V": ("V_u", 1.0),
-    "V_lower_V": ("V_l", 1.0),
-    "duty_upper": ("duty_u", 1.0),
-    "duty_lower": ("duty_l", 1.0),
-}
-_COL = {n: i for i, n in enumerate(OUT_COLUMNS)}
-
-
-def temp_path(path: str | Path) -> Path:
-    """A fresh hidden temporary name beside ``path`` (for write-then-rename)."""
-    path = Path(path)
-    return path.with_name(f".{path.name}.{uuid.uuid4().hex[:12]}.tmp")
-
-
-def atomic_write(path: str | Path, write) -> None:
-    """Write via a temporary file in the same directory, then rename: never half-written.
-
-    ``write(tmp)`` creates the temporary file itself, so the result gets the usual
-    permissions (umask), not the 0600 of :func:`tempfile.mkstemp`.
-    """
-    path = Path(path)
-    tmp = temp_path(path)
-    try:
-        write(str(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+from .engine.signals import columns
+from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older imports)
 
 
 @dataclass
 class SimulationResult:
-    """A run's signals (sampled at the output interval), metrics and run statistics."""
+    """A run's signals (sampled at the output interval), metrics and run statistics.
+
+    ``mechanism`` and ``wires`` are the recorded structured arrays (one row per sample; wires:
+    one column per wire); :meth:`signal` and the attributes named like the exported columns
+    (``result.theta_deg``, ``result.T_upper_C``) give them in the exported units.
+    """
 
     spec: Any
-    data: np.ndarray
+    mechanism: np.ndarray
+    wires: np.ndarray
     segment_start_s: np.ndarray
     segment_reached_s: np.ndarray
     substeps: int
@@ -76,30 +35,46 @@ class SimulationResult:
     _metrics: dict | None = field(default=None, repr=False)
 
     # ---- signals ---------------------------------------------------------------------
-    def raw(self, name: str) -> np.ndarray:
-        """A kernel signal in SI units (radians for angles)."""
-        return self.data[:, _COL[name]]
+    @property
+    def columns(self) -> list[tuple[str, str, str | int, float]]:
+        """Exported columns: (name, recorded field, "mechanism" or wire index, scale)."""
+        p = self.spec.params
+        return columns(p.mechanism, p.wire_names, p.coordinate.scale)
+
+    @property
+    def column_names(self) -> list[str]:
+        return [c[0] for c in self.columns]
 
     @property
     def t(self) -> np.ndarray:
-        return self.raw("t")
+        return self.mechanism["t"]
 
     def signal(self, name: str) -> np.ndarray:
-        """An exported signal by its column name (e.g. ``theta_deg``)."""
-        src, scale = EXPORT_COLUMNS[name]
-        if scale is None:
-            return self.raw(src) * (math.pi * self.spec.params.wire_diameter_m**2 / 4.0)
-        return self.raw(src) * scale
+        """An exported signal by its column name (e.g. ``theta_deg``, ``T_upper_C``)."""
+        for col, fld, where, scale in self.columns:
+            if col == name:
+                raw = self.mechanism[fld] if where == "mechanism" else self.wires[fld][:, where]
+                return raw if scale == 1.0 else raw * scale
+        raise KeyError(f"no signal {name!r} (signals: {', '.join(self.column_names)})")
 
     def __getattr__(self, name: str):
-        if name in EXPORT_COLUMNS:
+        if name.startswith("_") or name in ("spec", "mechanism", "wires"):
+            raise AttributeError(name)
+        try:
             return self.signal(name)
-        raise AttributeError(name)
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def decimated(self, every: int) -> "SimulationResult":
+        """The result thinned to every ``every``-th sample, its metrics kept at full resolution."""
+        metrics = self.metrics
+        return dataclasses.replace(self, mechanism=np.ascontiguousarray(self.mechanism[::every]),
+                                   wires=np.ascontiguousarray(self.wires[::every]), _metrics=metrics)
 
     def to_pandas(self):
         import pandas as pd
 
-        return pd.DataFrame({name: self.signal(name) for name in EXPORT_COLUMNS})
+        return pd.DataFrame({name: self.signal(name) for name in self.column_names})
 
     def to_csv(self, path: str | Path) -> None:
         df = self.to_pandas()
@@ -130,6 +105,7 @@ class SimulationResult:
         """Metrics plus run statistics, JSON-ready."""
         m = dict(self.metrics)
         m["params"] = self.spec.params.name
+        m["mechanism"] = self.spec.params.mechanism
         m["strategy"] = self.spec.strategy
         m["method"] = self.spec.method
         m["dt_s"] = self.spec.dt_s
@@ -185,39 +161,39 @@ def time_to_reach(t, theta_deg, target_deg, start, end, tol_deg, hold_s):
 
 def compute_metrics(result: SimulationResult) -> dict:
     spec = result.spec
+    p = spec.params
+    unit = p.coordinate.unit
+    names = p.wire_names
     t = result.t
-    th = result.signal("theta_deg")
-    Tu, Tl = result.raw("T_u"), result.raw("T_l")
-    su, sl = result.raw("sigma_u"), result.raw("sigma_l")
-    Eu, El = result.raw("E_u"), result.raw("E_l")
+    q = result.signal(f"{p.coordinate.name}_{unit}")
+    T, sigma, E = result.wires["T"], result.wires["sigma"], result.wires["energy"]
     segments = []
     for i, start, end in segment_bounds(result):
         seg = spec.profile.segments[i]
         m = (t >= start - 1e-12) & (t <= end + 1e-12)
         k0 = int(np.searchsorted(t, start - 1e-12))
         k1 = min(int(np.searchsorted(t, end - 1e-12)), len(t) - 1)
-        th0 = th[k0]
-        direction = np.sign(seg.target_deg - th0)
+        direction = np.sign(seg.target - q[k0])
         over = 0.0
         if direction != 0 and m.any():
-            over = max(0.0, float(np.max(direction * (th[m] - seg.target_deg))))
+            over = max(0.0, float(np.max(direction * (q[m] - seg.target))))
         segments.append({
             "index": i,
             "start_s": start,
             "end_s": end,
-            "target_deg": seg.target_deg,
+            f"target_{unit}": seg.target,
             "enable": seg.enable,
             "reached_s": None if math.isnan(result.segment_reached_s[i]) else float(result.segment_reached_s[i]),
-            "overshoot_deg": over,
-            "energy_J": {"upper": float(Eu[k1] - Eu[k0]), "lower": float(El[k1] - El[k0])},
-            "peak_temperature_C": {"upper": float(np.max(Tu[m])), "lower": float(np.max(Tl[m]))},
+            f"overshoot_{unit}": over,
+            "energy_J": {w: float(E[k1, j] - E[k0, j]) for j, w in enumerate(names)},
+            "peak_temperature_C": {w: float(np.max(T[m, j])) for j, w in enumerate(names)},
         })
     return {
         "segments": segments,
-        "tol_deg": spec.tol_deg,
+        f"tol_{unit}": spec.tolerance,
         "hold_s": spec.hold_s,
-        "energy_J": {"upper": float(Eu[-1]), "lower": float(El[-1])},
-        "peak_temperature_C": {"upper": float(np.max(Tu)), "lower": float(np.max(Tl))},
-        "peak_stress_Pa": {"upper": float(np.max(su)), "lower": float(np.max(sl))},
+        "energy_J": {w: float(E[-1, j]) for j, w in enumerate(names)},
+        "peak_temperature_C": {w: float(np.max(T[:, j])) for j, w in enumerate(names)},
+        "peak_stress_Pa": {w: float(np.max(sigma[:, j])) for j, w in enumerate(names)},
         "interlock_violations": result.interlock_violations,
     }

@@ -1,78 +1,122 @@
-"""Phase selection (end of Sec. 2.6) and the strategies of Sec. 4.
+"""Phase selection (end of Sec. 2.6) and the strategies of Sec. 4, for any number of wires.
 
-Phase selection: the upper actuator is in its heating phase while theta_F >= theta and in
-its cooling phase otherwise; the lower actuator is in its heating phase while
-theta_F <= theta (the paper states it for both signs of the desired rotation, and both
-statements reduce to this). In its heating phase an enabled actuator gets the PID duty
-(the lower one with the error's sign reversed); in its cooling phase it gets the same duty
-if the controller is kept on in cooling (Fig. 11 case i) and 0 V otherwise.
+Phase selection: a wire whose contraction raises q (the paper's upper actuator, direction +1)
+is in its heating phase while q_F >= q and in its cooling phase otherwise; a wire whose
+contraction lowers q (the lower actuator, direction -1) while q_F <= q (the paper states it for
+both signs of the desired rotation, and both statements reduce to this). In its heating phase
+an enabled wire gets the PID duty (with the error's sign reversed for direction -1); in its
+cooling phase it gets the same duty if the controller is kept on in cooling (Fig. 11 case i)
+and 0 V otherwise.
 
-Because the upper duty is clamp(u) and the lower one clamp(-u) from one PID output u, at
-most one of them is positive: the interlock (both wires never heated at once) holds by
-construction, and the engine checks it at every step anyway.
+Because a direction +1 wire gets clamp(u) and a direction -1 wire clamp(-u) from one PID
+output u, opposing wires are never both driven: the interlock (two opposing wires never heated
+at once) holds by construction, and the engine checks it at every step anyway.
 
 Strategies:
-- ``open-loop``: a piecewise-constant voltage program per wire, no controller.
-- ``independent`` (Sec. 4.1): one actuator at a time, the agonist of the desired rotation;
-  the other is a passive bias spring. Before a new agonist is used, the strategy waits for
-  the end of the previous agonist's cooling phase (its wire back to martensite).
-- ``cooperative`` (Sec. 4.2): both actuators enabled; the antagonist heats as soon as the
-  joint passes the target, i.e. just before the agonist starts cooling.
+- ``open-loop``: a piecewise-constant program per wire, no controller.
+- ``independent`` (Sec. 4.1): one actuator at a time, the agonist of the desired motion; the
+  other is a passive bias spring. Before a new agonist is used, the strategy waits for the end
+  of the previous agonist's cooling phase (its wire back to martensite).
+- ``cooperative`` (Sec. 4.2): every actuator enabled; the antagonist heats as soon as the
+  mechanism passes the target, i.e. just before the agonist starts cooling.
+
+Which wires are enabled is a bit mask (bit i: wire i); :data:`AUTO` lets the strategy choose.
 """
+
+from enum import IntEnum
+from typing import NamedTuple
 
 from numba import njit
 
-OPEN_LOOP = 0
-INDEPENDENT = 1
-COOPERATIVE = 2
-STRATEGIES = {"open-loop": OPEN_LOOP, "independent": INDEPENDENT, "cooperative": COOPERATIVE}
+from .pid import clamp_duty
 
-AUTO = 0
-UPPER = 1
-LOWER = 2
-BOTH = 3
-NONE = 4
-ENABLES = {"auto": AUTO, "upper": UPPER, "lower": LOWER, "both": BOTH, "none": NONE}
 
+class Strategy(IntEnum):
+    OPEN_LOOP = 0
+    INDEPENDENT = 1
+    COOPERATIVE = 2
+
+    @property
+    def label(self) -> str:
+        return self.name.lower().replace("_", "-")
+
+
+STRATEGIES = {s.label: s for s in Strategy}
+
+#: enable mask meaning "the strategy chooses"
+AUTO = -1
+#: no wire (an agonist index meaning none)
+NO_WIRE = -1
 #: martensite fraction above which the independent strategy deems a cooling phase over
 RELEASE_XI = 0.999
 
 
-@njit(cache=True)
-def upper_heating_phase(theta_F, theta):
-    """Sec. 2.6: the upper actuator heats while theta_F >= theta."""
-    return theta_F >= theta
+class Command(NamedTuple):
+    """What the controller commands one wire, held until the next control tick."""
+
+    enabled: bool
+    heating: bool  #: in its controller's heating phase (selects h, Eq. 11; and C_DF)
+    duty: float  #: DC% (Eq. 12)
+    level: float  #: drive while on: V_H, or the program's voltage/current
+
+
+def enable_mask(enable: str, wire_names: tuple[str, ...]) -> int:
+    """A profile segment's enable word as a bit mask (:data:`AUTO` for ``auto``)."""
+    if enable == "auto":
+        return AUTO
+    if enable == "none":
+        return 0
+    if enable in ("both", "all"):
+        return (1 << len(wire_names)) - 1
+    if enable in wire_names:
+        return 1 << wire_names.index(enable)
+    raise ValueError(f"enable {enable!r} is not one of auto, none, all, both, {', '.join(wire_names)}")
 
 
 @njit(cache=True)
-def lower_heating_phase(theta_F, theta):
-    """Sec. 2.6: the lower actuator heats while theta_F <= theta."""
-    return theta_F <= theta
+def is_enabled(mask, i):
+    return (mask >> i) & 1 == 1
+
+
+@njit(cache=True, inline="always")
+def heating_phase(direction, q_target, q):
+    """Sec. 2.6: the wire's heating phase (upper: theta_F >= theta; lower: theta_F <= theta)."""
+    if direction > 0.0:
+        return q_target >= q
+    return q_target <= q
+
+
+@njit(cache=True, inline="always")
+def wire_command(u, enabled, direction, q_target, q, keep_on_in_cooling, level):
+    """One wire's :class:`Command` from the PID output u [%]."""
+    if not enabled:
+        return Command(False, False, 0.0, level)
+    heating = heating_phase(direction, q_target, q)
+    duty = clamp_duty(direction * u) if heating or keep_on_in_cooling else 0.0
+    return Command(True, heating, duty, level)
 
 
 @njit(cache=True)
-def actuator_commands(u, enabled_u, enabled_l, theta_F, theta, keep_on_in_cooling):
-    """(duty_u, duty_l, heating_u, heating_l) from the PID output u [%]."""
-    duty_u = 0.0
-    duty_l = 0.0
-    heat_u = False
-    heat_l = False
-    if enabled_u:
-        heat_u = upper_heating_phase(theta_F, theta)
-        if heat_u or keep_on_in_cooling:
-            duty_u = min(max(u, 0.0), 100.0)
-    if enabled_l:
-        heat_l = lower_heating_phase(theta_F, theta)
-        if heat_l or keep_on_in_cooling:
-            duty_l = min(max(-u, 0.0), 100.0)
-    return duty_u, duty_l, heat_u, heat_l
+def agonist_of(wires, q_target, q, previous):
+    """Index of the first wire whose contraction moves q toward q_target (``previous`` at the target)."""
+    if q_target == q:
+        return previous
+    want = 1.0 if q_target > q else -1.0
+    for i in range(len(wires)):
+        if wires[i].direction == want:
+            return i
+    return NO_WIRE
 
 
-@njit(cache=True)
-def independent_agonist(theta_F, theta, previous):
-    """Agonist of the desired rotation: UPPER for positive, LOWER for negative."""
-    if theta_F > theta:
-        return UPPER
-    if theta_F < theta:
-        return LOWER
-    return previous
+@njit(cache=True, inline="always")
+def opposing_wires_driven(wires, drives, low):
+    """The interlock: two wires pulling opposite ways both driven above V_L."""
+    up = False
+    down = False
+    for i in range(len(wires)):
+        if drives[i] > low:
+            if wires[i].direction > 0.0:
+                up = True
+            else:
+                down = True
+    return up and down

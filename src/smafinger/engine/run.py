@@ -1,4 +1,4 @@
-"""Single-run API: validate the inputs, convert to SI ticks, call the compiled kernel."""
+"""Single-run API: validate the inputs, convert to SI ticks and records, call the compiled kernel."""
 
 from __future__ import annotations
 
@@ -8,14 +8,17 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from numba import typeof
 
-from ..control.strategies import ENABLES, STRATEGIES
-from ..model.layout import pack
+from ..control.strategies import STRATEGIES, enable_mask
+from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
 from ..profiles import ProfileError, TargetProfile, VoltageProgram
+from ..results import SimulationResult
 from . import integrators
-from .kernel import C_STATUS, C_SUBSTEPS, C_VIOLATIONS, N_COUNTERS, N_OUT, STATUS_BLOWUP, run_kernel
-from .rhs import N_STATE
+from .kernel import Program, RunSettings, run_kernel
+from .schedule import Segments
+from .signals import as_structured, new_outputs
 
 TICK_S = 1e-9
 DEFAULT_DT_S = 1e-3
@@ -24,8 +27,8 @@ DEFAULT_DT_S = 1e-3
 #: the open-loop Table II runs of Figs. 7-8 (a stiff joint-tendon mode): not a safe default.
 DEFAULT_METHOD = "rk4"
 DEFAULT_OUTPUT_S = 1e-3
-STATE_NAMES = ("theta_rad", "omega_rad_s", "T_upper_C", "T_lower_C", "sigma_upper_Pa",
-               "sigma_lower_Pa", "error_integral_rad_s", "E_upper_J", "E_lower_J")
+#: default target tolerance of the linear actuator [m]
+DEFAULT_TOL_M = 5e-4
 
 
 class SimulationError(RuntimeError):
@@ -59,24 +62,31 @@ def ticks_array(name: str, values_s: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class RunSpec:
-    """Everything one run needs, validated and in kernel form."""
+    """Everything one run needs, validated. Targets and tolerances in the mechanism's user unit."""
 
     params: ParameterSet
     strategy: str
     profile: TargetProfile
-    voltage: VoltageProgram | None
+    voltage: VoltageProgram | None  #: the open-loop drive program (voltage, duty or current)
     t_end_s: float
     dt_s: float
     method: str
     output_interval_s: float
-    tol_deg: float
+    tol_deg: float  #: target tolerance of the joint [deg]
     hold_s: float
     independent_wait: bool
+    tol_m: float = DEFAULT_TOL_M  #: target tolerance of the linear actuator [m]
+
+    @property
+    def tolerance(self) -> float:
+        """The target tolerance in the mechanism's user unit."""
+        return self.tol_deg if self.params.coordinate.unit == "deg" else self.tol_m
 
 
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
               t_end_s=20.0, dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S,
-              tol_deg=0.5, hold_s=0.5, independent_wait=True) -> RunSpec:
+              tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage") -> RunSpec:
+    """A validated :class:`RunSpec` (see :func:`simulate` for the arguments)."""
     p = resolve(params)
     if strategy not in STRATEGIES:
         raise ValueError(f"strategy = {strategy!r} is not one of {', '.join(STRATEGIES)}")
@@ -84,125 +94,184 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     if isinstance(profile, str):
         profile = TargetProfile.parse(profile)
     if isinstance(voltage, str):
-        voltage = VoltageProgram.parse(voltage)
+        voltage = VoltageProgram.parse(voltage, drive)
     if strategy == "open-loop":
         if voltage is None:
-            raise ProfileError("strategy open-loop needs a voltage program (--voltage T:V_UPPER:V_LOWER,...)")
+            raise ProfileError("strategy open-loop needs a voltage program (--voltage T:V_UPPER:V_LOWER,...) "
+                               "or another drive program (--duty, --current)")
         if profile is None:
-            profile = TargetProfile.constant(p.theta0_deg, "none")
+            profile = TargetProfile.constant(p.initial_target, "none")
     else:
         if profile is None:
-            raise ProfileError(f"strategy {strategy} needs a target profile (--profile T:ANGLE[:ENABLE],...)")
+            raise ProfileError(f"strategy {strategy} needs a target profile (--profile T:TARGET[:ENABLE],...)")
         if voltage is not None:
-            raise ProfileError(f"a voltage program is only used with strategy open-loop, not {strategy}")
-    for name, v in (("tol_deg", tol_deg), ("hold_s", hold_s)):
+            raise ProfileError(f"a drive program is only used with strategy open-loop, not {strategy}")
+    for name, v in (("tol_deg", tol_deg), ("tol_m", tol_m), ("hold_s", hold_s)):
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
     spec = RunSpec(p, strategy, profile, voltage, float(t_end_s), float(dt_s), method,
-                   float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait))
-    kernel_args(spec)  # validates the times
+                   float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m))
+    kernel_args(spec)  # validates the times, targets and program against the mechanism
     return spec
 
 
+def _segments(spec: RunSpec) -> Segments:
+    p = spec.params
+    coord = p.coordinate
+    start, target, enable = [], [], []
+    for i, s in enumerate(spec.profile.segments):
+        if abs(s.target) > coord.limit:
+            raise ProfileError(f"profile segment {i}: target {s.target} {coord.unit} is outside "
+                               f"[-{coord.limit:g}, {coord.limit:g}]")
+        try:
+            enable.append(enable_mask(s.enable, p.wire_names))
+        except ValueError as exc:
+            raise ProfileError(f"profile segment {i}: {exc}") from None
+        start.append(-1 if s.start_s is None else to_ticks("profile start", s.start_s, True))
+        target.append(p.to_si(s.target))
+    return Segments(np.array(start, dtype=np.int64), np.array(target), np.array(enable, dtype=np.int64))
+
+
+def _program(spec: RunSpec, model) -> Program:
+    p = spec.params
+    n = len(p.wire_names)
+    prog = spec.voltage
+    if prog is None:
+        return Program(np.zeros(0, dtype=np.int64), np.zeros((0, n)), np.zeros((0, n)))
+    if prog.n_wires != n:
+        raise ProfileError(f"{prog.kind} program: {prog.n_wires} value(s) per step, but a {p.mechanism} has "
+                           f"{n} wire(s) ({', '.join(p.wire_names)})")
+    cols = prog.arrays()
+    values = np.column_stack(cols[1:])
+    if prog.kind == "duty":
+        level, duty = np.full_like(values, p.V_H_V), 100.0 * values
+    else:
+        level, duty = values, np.where(values > 0.0, 100.0, 0.0)
+    directions = np.array([w.direction for w in model.wires])
+    both = ((duty > 0) & (level > 0) & (directions > 0)).any(axis=1) & ((duty > 0) & (level > 0) & (directions < 0)).any(axis=1)
+    if both.any():
+        i = int(np.flatnonzero(both)[0])
+        raise ProfileError(f"{prog.kind} program step {i} (t = {cols[0][i]} s): both wires heated at once "
+                           f"({', '.join(f'{v:g}' for v in values[i])}) would break the interlock")
+    return Program(ticks_array(f"{prog.kind} start", cols[0]), level, duty)
+
+
 def kernel_args(spec: RunSpec) -> dict:
-    """The plain arrays and integers the kernel takes."""
+    """The records and arrays the kernel takes (validated)."""
     t_end = to_ticks("t_end_s", spec.t_end_s)
     dt = to_ticks("dt_s", spec.dt_s)
-    out = to_ticks("output_interval_s", spec.output_interval_s)
-    pwm = to_ticks("pwm_period_s", spec.params.pwm_period_s)
-    upd = to_ticks("controller_update_s", spec.params.controller_update_s, allow_zero=True)
     if dt > t_end:
         raise ValueError(f"dt_s = {spec.dt_s} is longer than t_end_s = {spec.t_end_s}")
-    segs = spec.profile.segments
-    seg_start = np.array([-1 if s.start_s is None else to_ticks("profile start", s.start_s, True) for s in segs], dtype=np.int64)
-    seg_target = np.array([math.radians(s.target_deg) for s in segs])
-    seg_enable = np.array([ENABLES[s.enable] for s in segs], dtype=np.int64)
-    if spec.voltage is not None:
-        vs, vu, vl = spec.voltage.arrays()
-        vt = ticks_array("voltage start", vs)
-    else:
-        vt = np.zeros(0, dtype=np.int64)
-        vu = np.zeros(0)
-        vl = np.zeros(0)
-    return dict(
-        p=pack(spec.params), seg_start=seg_start, seg_target=seg_target, seg_enable=seg_enable,
-        strategy=STRATEGIES[spec.strategy], wait_release=spec.independent_wait,
-        volt_ticks=vt, volt_u=vu, volt_l=vl, method=integrators.get(spec.method).code,
-        dt_ticks=dt, tick_s=TICK_S, t_end_ticks=t_end, out_ticks=out, update_ticks=upd,
-        pwm_ticks=pwm, tol_rad=math.radians(spec.tol_deg), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
-    )
+    p = spec.params
+    run = RunSettings(
+        strategy=STRATEGIES[spec.strategy], method=integrators.get(spec.method).code,
+        wait_release=spec.independent_wait,
+        current_drive=spec.voltage is not None and spec.voltage.kind == "current",
+        tick_s=TICK_S, dt_ticks=dt, t_end_ticks=t_end,
+        out_ticks=to_ticks("output_interval_s", spec.output_interval_s),
+        update_ticks=to_ticks("controller_update_s", p.controller_update_s, allow_zero=True),
+        pwm_ticks=to_ticks("pwm_period_s", p.pwm_period_s),
+        tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True))
+    model = build_model(p)
+    return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
-def run_spec(spec: RunSpec, progress: bool = False):
+def _compiled_for(args: dict) -> bool:
+    """Is the kernel already compiled (or loaded from the cache) for these record types?"""
+    want = tuple(typeof(args[k]) for k in ("model", "run", "segs", "prog"))
+    return any(tuple(sig[:4]) == want for sig in run_kernel.signatures)
+
+
+def _call(args: dict, mech, wires, seg_actual, seg_reached):
+    return run_kernel(args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached)
+
+
+def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
     """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`."""
-    from ..results import SimulationResult
-
     args = kernel_args(spec)
-    n_out = args["t_end_ticks"] // args["out_ticks"] + 1
-    out = np.full((n_out, N_OUT), np.nan)
-    seg_actual = np.full(len(spec.profile.segments), -1, dtype=np.int64)
-    seg_reached = np.full(len(spec.profile.segments), -1, dtype=np.int64)
-    counters = np.zeros(N_COUNTERS + 1, dtype=np.int64)
-    err = np.zeros(1 + N_STATE)
-    call = lambda: run_kernel(out=out, seg_actual=seg_actual, seg_reached=seg_reached, counters=counters, err_state=err, **args)  # noqa: E731
-    if not run_kernel.signatures:
+    run = args["run"]
+    n_wires = len(spec.params.wire_names)
+    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, n_wires)
+    n_seg = len(spec.profile.segments)
+    seg_actual = np.full(n_seg, -1, dtype=np.int64)
+    seg_reached = np.full(n_seg, -1, dtype=np.int64)
+    if not _compiled_for(args):
         # compile (or load from the cache) on a one-step run, so wall_s times the loop alone
-        warm = dict(args, t_end_ticks=args["dt_ticks"], out_ticks=args["dt_ticks"])
-        run_kernel(out=np.full((2, N_OUT), np.nan), seg_actual=seg_actual.copy(), seg_reached=seg_reached.copy(),
-                   counters=np.zeros_like(counters), err_state=np.zeros_like(err), **warm)
+        warm = dict(args, run=run._replace(t_end_ticks=run.dt_ticks, out_ticks=run.dt_ticks))
+        _call(warm, *new_outputs(2, n_wires), seg_actual.copy(), seg_reached.copy())
     t0 = time.perf_counter()
     if progress:
-        _run_with_progress(call, out, spec.t_end_s)
+        counters, state, t_fail = _run_with_progress(lambda: _call(args, mech, wires, seg_actual, seg_reached),
+                                                     mech, spec.t_end_s)
     else:
-        call()
+        counters, state, t_fail = _call(args, mech, wires, seg_actual, seg_reached)
     wall = time.perf_counter() - t0
-    if counters[C_STATUS] == STATUS_BLOWUP:
-        state = ", ".join(f"{n}={v:.6g}" for n, v in zip(STATE_NAMES, err[1:]))
-        raise SimulationError(f"numerical blow-up at t = {err[0]:.9g} s: {state}")
+    if counters.status != 0:
+        raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
+    mech, wires = as_structured(mech, wires)
     return SimulationResult(
-        spec=spec, data=out, segment_start_s=seg_actual * TICK_S,
-        segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan), substeps=int(counters[C_SUBSTEPS]),
-        interlock_violations=int(counters[C_VIOLATIONS]), wall_s=wall,
-    )
+        spec=spec, mechanism=mech, wires=wires, segment_start_s=seg_actual * TICK_S,
+        segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
+        substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall)
 
 
-def _run_with_progress(call, out, t_end_s):
+def describe_state(p: ParameterSet, state) -> str:
+    """The state, every value named (for error messages)."""
+    si = "rad" if p.mechanism == "joint" else "m"
+    coord, rate = (("theta", "omega"), ("position", "velocity"))[p.mechanism != "joint"]
+    parts = [f"{coord}_{si}={state.q:.6g}", f"{rate}_{si}_s={state.v:.6g}",
+             f"error_integral={state.error_integral:.6g}"]
+    for name, w in zip(p.wire_names, state.wires):
+        parts += [f"T_{name}_C={w.T_C:.6g}", f"sigma_{name}_Pa={w.sigma_Pa:.6g}",
+                  f"energy_{name}_J={w.electrical_J:.6g}"]
+    return ", ".join(parts)
+
+
+def _run_with_progress(call, mech, t_end_s):
     """Run the (nogil) kernel in a thread and show its progress from the output rows."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-    th = threading.Thread(target=call)
+    box = []
+    th = threading.Thread(target=lambda: box.append(call()))
     with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed:.1f}/{task.total:.1f} s"),
                   TimeRemainingColumn(), transient=True) as bar:
         task = bar.add_task("sim", total=t_end_s)
         th.start()
         while th.is_alive():
             th.join(0.1)
-            done = out[:, 0]
+            done = mech.t
             filled = done[~np.isnan(done)]
             bar.update(task, completed=float(filled[-1]) if filled.size else 0.0)
+    return box[0]
 
 
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
              dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
-             hold_s=0.5, independent_wait=True, progress=False):
-    """Simulate the finger joint.
+             hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage"):
+    """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
     ----------
     params : str, path or ParameterSet
-        A named set (``paper2010``, ``authors2020``, ...), a TOML file, or a set.
+        A named set (``paper2010``, ``authors2020``, ``linear-bias-spring``, ...), a TOML file,
+        or a set. The set's mechanism decides the units of targets and outputs.
     strategy : {"open-loop", "independent", "cooperative"}
     profile : str or TargetProfile
-        Target schedule ``"T:ANGLE[:ENABLE],..."`` (degrees, seconds; ``reach`` as T starts a
-        segment when the previous target is reached).
+        Target schedule ``"T:TARGET[:ENABLE],..."`` (seconds; degrees for the joint, metres for
+        the linear actuator; ``reach`` as T starts a segment when the previous target is reached).
     voltage : str or VoltageProgram
-        Open-loop program ``"T:V_UPPER:V_LOWER,..."``.
+        Open-loop program ``"T:V_1[:V_2],..."``: one value per wire (upper, lower for the joint),
+        read as ``drive`` says.
+    drive : {"voltage", "duty", "current"}
+        How a text ``voltage`` program is read: volts, fractions of the supply V_H (switched at
+        the PWM period), or amperes.
     t_end_s, dt_s, output_interval_s : float
         Simulated time, step and output sampling interval [s] (whole nanoseconds).
     method : {"rk4", "euler"}
         Fixed-step integrator (default :data:`DEFAULT_METHOD`, rk4).
-    tol_deg, hold_s : float
-        A target counts as reached once within ``tol_deg`` for ``hold_s``.
+    tol_deg, tol_m, hold_s : float
+        A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
+        actuator) for ``hold_s``.
     independent_wait : bool
         Independent strategy: wait for the previous agonist's cooling phase to end before
         using the other actuator (Sec. 4.1).
@@ -212,5 +281,5 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     SimulationResult
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
-                     tol_deg, hold_s, independent_wait)
+                     tol_deg, hold_s, independent_wait, tol_m, drive)
     return run_spec(spec, progress=progress)

@@ -93,3 +93,27 @@ def secant_modulus_authors(eps_el, D, K_S, x_limit, fact, S_w, L_w):
     x_spring = K_D * L_w * eps_el / (K_D + K_S)
     K_s = spring_stiffness(x_spring, K_S, x_limit, fact)
     return equivalent_modulus(K_s, D, S_w, L_w), x_spring
+
+
+@njit(cache=True, inline="always")
+def rate_law_modulus(wire, sigma, D):
+    """(D_eq, spring elongation) of Eq. (8) for the rate law at stress sigma.
+
+    Through a spring-slack tendon the wire and spring act in series; a wire that pulls
+    directly (``series_rigid``) has D_eq = D and no spring.
+    """
+    if wire.series_rigid:
+        return D, 0.0
+    x_s = spring_elongation(sigma * wire.area_m2, wire.series_K_N_m, wire.series_limit_m,
+                            wire.series_penalty_per_mm)
+    K_s = spring_stiffness(x_s, wire.series_K_N_m, wire.series_limit_m, wire.series_penalty_per_mm)
+    return equivalent_modulus(K_s, D, wire.area_m2, wire.wire_length_m), x_s
+
+
+@njit(cache=True, inline="always")
+def secant_modulus(wire, eps_el, D):
+    """(D_eq, spring elongation) of the algebraic law at elastic strain eps_el (wire + spring)."""
+    if wire.series_rigid:
+        return D, 0.0
+    return secant_modulus_authors(eps_el, D, wire.series_K_N_m, wire.series_limit_m,
+                                  wire.series_penalty_per_mm, wire.area_m2, wire.wire_length_m)

@@ -1,28 +1,48 @@
-"""Eqs. (3)-(6): tendon path, total-strain variation and moment arm.
+"""Eqs. (3)-(6): a wire's path to the mechanism, its change with q, and its moment arm.
 
-Frame O-XY at the MCP joint centre; theta from the X axis, positive = extension.
-Point B on the phalanx (Eq. 3): B = r (cos(theta + alpha0), sin(theta + alpha0)).
-Fixed points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1); lower
-C_L = (-a4, -a1), D_L = (+a2, -a1).
-
-Configuration switch: while Y_B(upper) >= Y_C(upper) (finger up or level) the upper tendon
-runs straight C_U -> B_U (Configuration I, Eq. 4) and the lower wraps over D_L
-(Configuration II, Eq. 5); otherwise the upper wraps over D_U and the lower runs straight.
-The path length includes the fixed segment |C D| when wrapped, so that it is continuous at
-the switch; Eq. (6): Delta eps = (path(theta) - path(theta0)) / L_w.
-The moment arm is b = |X_B Y_P - X_P Y_B| / |P B| with P the point the tendon leaves from
+Joint (:class:`TendonRoute`). Frame O-XY at the MCP joint centre; theta from the X axis,
+positive = extension. Point B on the phalanx (Eq. 3): B = r (cos(theta + alpha0),
+sin(theta + alpha0)). Fixed points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1);
+lower C_L = (-a4, -a1), D_L = (+a2, -a1). Configuration switch: while Y_B(upper) >= Y_C(upper)
+(finger up or level) the upper tendon runs straight C_U -> B_U (Configuration I, Eq. 4) and
+the lower wraps over D_L (Configuration II, Eq. 5); otherwise the upper wraps over D_U and the
+lower runs straight. The path length includes the fixed segment |C D| when wrapped, so that it
+is continuous at the switch; Eq. (6): Delta eps = (path(theta) - path(theta0)) / L_w. The
+moment arm is b = |X_B Y_P - X_P Y_B| / |P B| with P the point the tendon leaves from
 (Eqs. 4b, 5b); it equals |d path / d theta|.
+
+Linear actuator (:class:`DirectPull`): the wire pulls the slider along its own axis, so its
+path shortens by exactly the slider's displacement: d path / d x = -1.
+
+:func:`route` gives (path, d path / d q, arm) for either; a wire's generalized force is
+``-F d path / d q`` (virtual work), which is F b for the upper tendon and -F b for the lower.
 """
 
 import math
+from typing import NamedTuple
 
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 
-@njit(cache=True)
-def upper_is_straight(theta, r, alpha0_upper, a1):
-    """Configuration I for the upper tendon: Y of B_U >= Y of C_U."""
-    return r * math.sin(theta + alpha0_upper) >= a1
+class TendonRoute(NamedTuple):
+    """One tendon of the joint (Eqs. 3-5); the switch is the upper B passing C_U's height."""
+
+    r_m: float  #: |OB|
+    alpha0_rad: float  #: angle of B at theta = 0
+    C_x_m: float
+    C_y_m: float
+    D_x_m: float
+    D_y_m: float
+    switch_alpha0_rad: float  #: the configuration switch: "up" while r sin(theta + this) >= switch_y_m
+    switch_y_m: float
+    wrapped_when_up: bool  #: the lower tendon wraps over D while the finger is up, the upper while down
+
+
+class DirectPull(NamedTuple):
+    """A wire pulling a slider along its axis."""
+
+    dpath_dq: float  #: -1: the path shortens as the slider moves in the pulling direction
 
 
 @njit(cache=True)
@@ -49,10 +69,35 @@ def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     return fixed + dpb, dpath, arm
 
 
+@njit(cache=True, inline="always")
+def tendon_route(rt, theta):
+    """(path, dpath/dtheta, arm) of a joint tendon, with its Configuration I/II switch."""
+    up = rt.r_m * math.sin(theta + rt.switch_alpha0_rad) >= rt.switch_y_m
+    wrapped = up if rt.wrapped_when_up else not up
+    return tendon(theta, rt.r_m, rt.alpha0_rad, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
+
+
+@njit(cache=True, inline="always")
+def direct_pull(rt, x):
+    """(path, dpath/dx, arm) of a wire pulling a slider: path = -x from the start."""
+    return rt.dpath_dq * x, rt.dpath_dq, 1.0
+
+
+def route(rt, q):
+    """(path [m], d path / d q, arm) of a wire at coordinate q; dispatched on the route's type."""
+    raise NotImplementedError("route() is compiled code: call it from a numba function")
+
+
+@overload(route)
+def _route(rt, q):
+    if isinstance(rt, types.BaseNamedTuple) and rt.instance_class is TendonRoute:
+        return lambda rt, q: tendon_route(rt, q)
+    if isinstance(rt, types.BaseNamedTuple) and rt.instance_class is DirectPull:
+        return lambda rt, q: direct_pull(rt, q)
+    return None
+
+
 @njit(cache=True)
-def both_tendons(theta, r, a0u, a0l, a1, a2, a4, a5):
-    """(path_U, dpath_U, arm_U, path_L, dpath_L, arm_L) at angle theta."""
-    straight_u = upper_is_straight(theta, r, a0u, a1)
-    pu, du, bu = tendon(theta, r, a0u, -a5, a1, a2, a1, not straight_u)
-    pl, dl, bl = tendon(theta, r, a0l, -a4, -a1, a2, -a1, straight_u)
-    return pu, du, bu, pl, dl, bl
+def wire_route(rt, q):
+    """:func:`route`, also callable from Python (compiled once per route type)."""
+    return route(rt, q)

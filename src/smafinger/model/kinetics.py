@@ -14,12 +14,27 @@ For a major loop xi_M0 = 1 and xi_A0 = 0.
 """
 
 import math
+from typing import NamedTuple
 
 from numba import njit
 
 HOLD = 0
 HEATING = 1
 COOLING = 2
+
+
+class Branch(NamedTuple):
+    """A wire's kinetics branch, held over a sub-step (minor loops: MODEL-NOTES)."""
+
+    branch: int  #: HOLD, HEATING or COOLING
+    start: float  #: xi_M0 on the heating branch (Eq. 9b), xi_A0 on the cooling branch (Eq. 10b)
+    held: float  #: xi on the hold branch
+    turn_C: float  #: extreme temperature since the last change (dead-band rule)
+
+
+def initial_branch(xi_init: float, T_init_C: float) -> Branch:
+    """A wire at rest: on the hold branch at its initial xi."""
+    return Branch(HOLD, xi_init, xi_init, T_init_C)
 
 
 @njit(cache=True)
@@ -140,3 +155,24 @@ def branch_of(dT_dt):
     if dT_dt < 0.0:
         return COOLING
     return HOLD
+
+
+@njit(cache=True, inline="always")
+def xi_on_branch(b, T, sigma, wire):
+    """xi and its partials (dxi/dT, dxi/dsigma) of a wire on branch ``b`` (Eqs. 9b, 10b)."""
+    return martensite_fraction(b.branch, b.start, b.held, T, sigma, wire.A_S0_C, wire.A_F0_C,
+                               wire.c_A_Pa_per_C, wire.M_S0_C, wire.M_F0_C, wire.c_M_Pa_per_C)
+
+
+@njit(cache=True)
+def enter_branch(b, new_branch, turn_C, xi_now, T, sigma, wire):
+    """The branch record on entering ``new_branch`` with xi = ``xi_now`` at (T, sigma).
+
+    The start value is re-solved so that the new branch passes through xi_now (continuous xi
+    through the reversal); on the hold branch xi stays at xi_now.
+    """
+    if new_branch == HOLD:
+        return Branch(new_branch, b.start, xi_now, turn_C)
+    start = branch_start(new_branch, xi_now, T, sigma, wire.A_S0_C, wire.A_F0_C, wire.c_A_Pa_per_C,
+                         wire.M_S0_C, wire.M_F0_C, wire.c_M_Pa_per_C)
+    return Branch(new_branch, start, b.held, turn_C)

@@ -11,13 +11,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-from . import authors2020, paper2010
-from .base import ParameterError, ParameterSet, load_toml
+from . import authors2020, linear_bias_spring, paper2010
+from .base import ParameterSet, field_spec, parse_value
+from .errors import ParameterError
+from .files import load_toml as _load_toml
+from .mechanisms import MECHANISMS, JointParameters, LinearActuatorParameters
+from .options import ModelOptions
 
 REGISTRY: dict[str, Callable[[], ParameterSet]] = {
     "paper2010": paper2010.parameters,
     "paper2010-table2": paper2010.table2,
     "authors2020": authors2020.parameters,
+    "linear-bias-spring": linear_bias_spring.parameters,
 }
 
 
@@ -35,6 +40,11 @@ def get(name: str) -> ParameterSet:
         ) from None
 
 
+def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet] = get) -> ParameterSet:
+    """A set from a TOML file (``base = "NAME"`` starts from a named set)."""
+    return _load_toml(path, registry_get)
+
+
 def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
     """A set from a name, a TOML path, or a set."""
     if isinstance(spec, ParameterSet):
@@ -43,8 +53,9 @@ def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
     if s in REGISTRY:
         return get(s)
     if s.endswith(".toml") or Path(s).exists():
-        return load_toml(s, get)
+        return load_toml(s)
     return get(s)
 
 
-__all__ = ["ParameterError", "ParameterSet", "get", "names", "resolve", "load_toml", "REGISTRY"]
+__all__ = ["ParameterError", "ParameterSet", "JointParameters", "LinearActuatorParameters", "ModelOptions",
+           "MECHANISMS", "get", "names", "resolve", "load_toml", "field_spec", "parse_value", "REGISTRY"]

@@ -9,14 +9,14 @@ evaluated at every step and 0 V in the cooling phase, error integral never reset
 switched by the enable flags, stress algebraic, friction holding only at the start.
 """
 
-from .base import ParameterSet
 from .geometry import GEOMETRY
+from .mechanisms import JointParameters
 from .paper2010 import parameters as _paper
 
 SOURCE = "Gilardi, FingerControl Simulink model (github.com/gabrielegilardi/FingerControl), 2020"
 
 
-def parameters() -> ParameterSet:
+def parameters() -> JointParameters:
     return _paper().replace(
         name="authors2020",
         source=SOURCE,

@@ -14,6 +14,7 @@ Choices of ours where the paper is silent (named options of the model):
 ``spring_init = "equilibrium"`` (upper spring solved from the moment balance, MODEL-NOTES),
 ``friction_sticking = "restick"``, ``damping_switch = "heating-phase"``,
 ``integral_reset = "segment"``, ``controller_in_cooling = True`` (Fig. 11 case i),
+``joule_heating = "per-metre"`` (Eq. 11 read literally, MODEL-NOTES),
 ``minor_loop_reversal_C = 0.5`` (a kinetics branch switches after a 0.5 degC reversal, so
 that the 1 kHz PWM ripple does not ratchet xi through minor loops; 0 is the literal
 sign-of-dT/dt rule of the authors' model).
@@ -22,14 +23,30 @@ sign-of-dT/dt rule of the authors' model).
 phases, as used in the parametric analysis of Sec. 3.1 (Figs. 7-8).
 """
 
-from .base import ParameterSet
 from .geometry import GEOMETRY
+from .mechanisms import JointParameters
+from .options import (
+    AntiWindup, DampingSwitch, FrictionSticking, IntegralReset, JouleHeating, ModelOptions, SpringInit, StressLaw,
+)
 
 SOURCE = "Gilardi et al., Robotica 28(5):675-687, 2010, Table II and Sec. 3.2"
 
 
-def parameters() -> ParameterSet:
-    return ParameterSet(
+#: the paper's model options (and our choices where it is silent, see above)
+OPTIONS = ModelOptions(
+    spring_init=SpringInit.EQUILIBRIUM,
+    stress_law=StressLaw.RATE,
+    friction_sticking=FrictionSticking.RESTICK,
+    damping_switch=DampingSwitch.HEATING_PHASE,
+    integral_reset=IntegralReset.SEGMENT,
+    anti_windup=AntiWindup.NONE,
+    controller_in_cooling=True,
+    joule_heating=JouleHeating.PER_METRE,
+)
+
+
+def parameters() -> JointParameters:
+    return JointParameters(
         name="paper2010",
         source=SOURCE,
         wire_density_kg_m3=6450.0,
@@ -66,7 +83,6 @@ def parameters() -> ParameterSet:
         theta0_deg=-40.0,
         spring_length_upper_m=17.4e-3,
         spring_length_lower_m=15.5e-3,
-        spring_init="equilibrium",
         V_H_V=8.0,
         V_L_V=0.0,
         pwm_period_s=1e-3,
@@ -74,17 +90,12 @@ def parameters() -> ParameterSet:
         K_V_s_per_rad=3000.0,
         K_I_per_rad_s=50.0,
         controller_update_s=0.01,
-        controller_in_cooling=True,
-        integral_reset="segment",
-        anti_windup="none",
-        stress_law="rate",
-        friction_sticking="restick",
-        damping_switch="heating-phase",
+        options=OPTIONS,
         **GEOMETRY,
     )
 
 
-def table2() -> ParameterSet:
+def table2() -> JointParameters:
     """Table II as printed: h0 = 70, h2 = 0.001, C_DF = 0.02 in both phases (Sec. 3.1)."""
     return parameters().replace(
         name="paper2010-table2",

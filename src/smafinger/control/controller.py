@@ -1,0 +1,52 @@
+"""The control tick: what each wire is commanded until the next tick (Eq. 12, Sec. 2.6).
+
+Closed loop: one PID output u (Eq. 12a) on the error q_F - q, turned into a duty per enabled
+wire by :func:`~smafinger.control.strategies.wire_command`. Open loop: a program gives each
+wire its drive level and duty. Both return a tuple of
+:class:`~smafinger.control.strategies.Command`, one per wire.
+"""
+
+from numba import njit
+
+from ..engine.tuples import filled, set_item
+from ..parameters.options import AntiWindup, DampingSwitch
+from .pid import pid_output, saturated_against
+from .strategies import Command, is_enabled, wire_command
+
+
+@njit(cache=True, inline="always")
+def pid_commands(model, enabled, q_target, state, level):
+    """(commands, integrating): the PID (Eq. 12a) and the phase selection of Sec. 2.6.
+
+    ``integrating`` is 0.0 while anti-windup freezes the error integral.
+    """
+    c = model.controller
+    e = q_target - state.q
+    u = pid_output(e, -state.v, state.error_integral, c.K_P, c.K_V, c.K_I)
+    keep_on = model.options.controller_in_cooling
+    w = model.wires
+    cmds = filled(w, wire_command(u, is_enabled(enabled, 0), w[0].direction, q_target, state.q, keep_on, level))
+    for i in range(1, len(w)):
+        cmds = set_item(cmds, i, wire_command(u, is_enabled(enabled, i), w[i].direction, q_target, state.q,
+                                              keep_on, level))
+    frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)
+    return cmds, 0.0 if frozen else 1.0
+
+
+@njit(cache=True, inline="always")
+def program_commands(cmds, levels, duties):
+    """Open loop: each wire at its program's level and duty (enabled while both are positive)."""
+    for i in range(len(cmds)):
+        on = levels[i] > 0.0 and duties[i] > 0.0
+        cmds = set_item(cmds, i, Command(on, on, duties[i] if on else 0.0, levels[i]))
+    return cmds
+
+
+@njit(cache=True, inline="always")
+def viscous_coefficient(dynamics, cmds, rule):
+    """C_DF: the heating value while any wire heats (or is enabled, per ``rule``), else cooling."""
+    hot = False
+    for i in range(len(cmds)):
+        if (cmds[i].enabled if rule == DampingSwitch.ENABLED else cmds[i].heating):
+            hot = True
+    return dynamics.viscous_heating if hot else dynamics.viscous_cooling

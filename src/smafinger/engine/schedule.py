@@ -1,0 +1,102 @@
+"""The target schedule (Eq. 12a's theta_F(t)) and the strategies' choice of enabled wires.
+
+A profile is a list of segments (start, target, enable); a start of -1 means "when the
+previous target has been reached" (within a tolerance, for a hold time). :func:`advance`
+starts the segments that are due; :func:`track_reach` records when each target was reached.
+"""
+
+from typing import NamedTuple
+
+from numba import njit
+
+from ..control.strategies import AUTO, NO_WIRE, RELEASE_XI, Strategy, agonist_of
+from ..model.wire import wire_stress_xi
+from .tuples import with_field
+
+#: an enable mask with every wire's bit set
+ALL_WIRES = (1 << 62) - 1
+
+
+class Segments(NamedTuple):
+    start: object  #: int64[n] ticks, -1: on reach
+    target: object  #: float64[n], SI (rad or m)
+    enable: object  #: int64[n] wire masks, AUTO: the strategy chooses
+
+
+class Schedule(NamedTuple):
+    next_seg: int  #: index of the next segment to start
+    q_target: float
+    enabled: int  #: bit mask of enabled wires
+    agonist: int  #: independent strategy: wire in use (NO_WIRE: none yet)
+    waiting: bool  #: independent strategy: waiting for the previous agonist to cool
+    wait_wire: int
+    pending: int  #: the agonist to enable once the wait is over
+    band_since: int  #: tick since which q has stayed within the tolerance (-1: outside)
+    confirmed: bool  #: the current target has been reached (held for the hold time)
+
+
+def initial_schedule(q0: float) -> Schedule:
+    return Schedule(0, q0, 0, NO_WIRE, False, NO_WIRE, NO_WIRE, -1, False)
+
+
+@njit(cache=True)
+def _xi(model, state, inputs, geom, i):
+    """xi of wire i at the state, on its current branch."""
+    return wire_stress_xi(model.wires[i], state.wires[i], inputs.wires[i].branch, geom.routes[i][0],
+                          model.options.stress_law)[1]
+
+
+@njit(cache=True)
+def _independent(s, target, model, state, inputs, geom, wait_release):
+    """Sec. 4.1: enable the agonist, after the previous one has cooled back to martensite."""
+    ag = agonist_of(model.wires, target, state.q, s.agonist)
+    if (wait_release and s.agonist != NO_WIRE and ag != s.agonist
+            and _xi(model, state, inputs, geom, s.agonist) < RELEASE_XI):
+        return Schedule(s.next_seg, target, 0, ag, True, s.agonist, ag, -1, False)
+    return Schedule(s.next_seg, target, 0 if ag == NO_WIRE else 1 << ag, ag, False, s.wait_wire, s.pending,
+                    -1, False)
+
+
+@njit(cache=True, inline="always")
+def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs, geom):
+    """Start every segment due at tick t; end an independent strategy's wait if it is over.
+
+    Returns (schedule, started: a segment started or the wait ended).
+    """
+    started = False
+    while s.next_seg < len(segs.start):
+        k = s.next_seg
+        st = segs.start[k]
+        if not ((st >= 0 and st <= t) or (st < 0 and s.confirmed)):
+            break
+        seg_actual[k] = t
+        target = segs.target[k]
+        en = segs.enable[k]
+        if strategy == Strategy.OPEN_LOOP:
+            s = Schedule(k, target, s.enabled, s.agonist, False, s.wait_wire, s.pending, -1, False)
+        elif en == AUTO and strategy == Strategy.COOPERATIVE:
+            s = Schedule(k, target, ALL_WIRES, s.agonist, False, s.wait_wire, s.pending, -1, False)
+        elif en == AUTO and strategy == Strategy.INDEPENDENT:
+            s = _independent(s, target, model, state, inputs, geom, wait_release)
+        else:
+            s = Schedule(k, target, en, s.agonist, False, s.wait_wire, s.pending, -1, False)
+        s = with_field(s, "next_seg", k + 1)
+        started = True
+    if s.waiting and _xi(model, state, inputs, geom, s.wait_wire) >= RELEASE_XI:
+        s = with_field(with_field(s, "waiting", False), "enabled", 1 << s.pending)
+        started = True
+    return s, started
+
+
+@njit(cache=True, inline="always")
+def track_reach(s, t, q, tol, hold_ticks, seg_reached):
+    """Record when the current target was entered for good (within ``tol`` for ``hold_ticks``)."""
+    if abs(q - s.q_target) <= tol:
+        band = t if s.band_since < 0 else s.band_since
+        confirmed = s.confirmed
+        if t - band >= hold_ticks and not confirmed:
+            confirmed = True
+            if s.next_seg >= 1:
+                seg_reached[s.next_seg - 1] = band
+        return with_field(with_field(s, "band_since", band), "confirmed", confirmed)
+    return with_field(s, "band_since", -1)

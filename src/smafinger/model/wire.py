@@ -1,0 +1,122 @@
+"""One SMA wire: its stress, martensite fraction and temperature rate (Eqs. 6-11 together).
+
+The wire's total strain follows the mechanism (Eq. 6: Delta eps = Delta path / L_w), its
+martensite fraction the kinetics branch (Eqs. 9-10), its stress the constitutive law (Eqs. 7-8,
+rate or algebraic form) and its temperature the heat balance (Eq. 11).
+"""
+
+from numba import njit
+
+from ..parameters.options import StressLaw
+from .constitutive import rate_law_modulus, secant_modulus, stress_rate, youngs_modulus
+from .heat import wire_temperature_rate
+from .kinetics import xi_on_branch
+
+
+@njit(cache=True)
+def _secant_stress(wire, eps_total, T, branch, sigma):
+    """S(sigma) = D_eq (eps - eps_R xi) with xi = xi(T, sigma): the stress the strain implies.
+
+    Returns (S, xi, spring elongation). S decreases as sigma grows (more stress, more martensite,
+    less elastic strain and a softer wire), so sigma = S(sigma) has exactly one root.
+    """
+    xi = xi_on_branch(branch, T, sigma, wire)[0]
+    eps_el = eps_total - wire.eps_R * xi
+    if eps_el <= 0.0:
+        return 0.0, xi, 0.0
+    D_eq, x_s = secant_modulus(wire, eps_el, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))
+    return D_eq * eps_el, xi, x_s
+
+
+@njit(cache=True)
+def _bracketed_stress(wire, eps_total, T, branch):
+    """The root of sigma - S(sigma) by the Illinois method on [0, S(0)] (always converges)."""
+    lo, g_lo = 0.0, -_secant_stress(wire, eps_total, T, branch, 0.0)[0]
+    if g_lo >= 0.0:
+        return 0.0
+    hi = -g_lo
+    g_hi = hi - _secant_stress(wire, eps_total, T, branch, hi)[0]
+    side = 0
+    x = hi
+    for _ in range(100):
+        if g_hi == g_lo:
+            break
+        x = (lo * g_hi - hi * g_lo) / (g_hi - g_lo)
+        g = x - _secant_stress(wire, eps_total, T, branch, x)[0]
+        if abs(g) <= 1e-9 * (1.0 + abs(x)) or hi - lo <= 1e-12 * (1.0 + hi):
+            break
+        if g > 0.0:
+            hi, g_hi = x, g
+            if side == 1:
+                g_lo *= 0.5
+            side = 1
+        else:
+            lo, g_lo = x, g
+            if side == -1:
+                g_hi *= 0.5
+            side = -1
+    return x
+
+
+@njit(cache=True)
+def algebraic_stress(wire, eps_total, T, branch):
+    """Authors' 2020 law: sigma = D_eq (eps - eps_R xi), solved together with xi(T, sigma).
+
+    Fixed-point iteration first (through a spring-slack tendon the xi-sigma coupling is weak,
+    contraction about 0.05: a few iterations, as in the authors' model); if it has not
+    converged in 12 (a wire pulling directly is a hundred times stiffer), the root is bracketed
+    instead (:func:`_bracketed_stress`). Returns (sigma, xi, spring elongation).
+    """
+    sigma = 0.0
+    x_s = 0.0
+    for _ in range(12):
+        sigma_new, _, x_s = _secant_stress(wire, eps_total, T, branch, sigma)
+        if abs(sigma_new - sigma) <= 1e-9 * (1.0 + abs(sigma_new)):
+            # converged: xi at the solution, the spring as the last iterate left it
+            return sigma_new, xi_on_branch(branch, T, sigma_new, wire)[0], x_s
+        sigma = sigma_new
+    sigma = _bracketed_stress(wire, eps_total, T, branch)
+    _, xi, x_s = _secant_stress(wire, eps_total, T, branch, sigma)
+    return sigma, xi, x_s
+
+
+@njit(cache=True, inline="always")
+def total_strain(wire, path):
+    """Total strain of wire + spring at path length ``path`` (Eq. 6), for the algebraic law."""
+    return wire.eps_total0 + (path - wire.path0_m) / wire.wire_length_m
+
+
+@njit(cache=True, inline="always")
+def rate_law(wire, sigma, T, dT, branch, dpath, v):
+    """Rate-form law (Eq. 7b) for one wire: (dsigma/dt, xi, spring elongation)."""
+    xi, xT, xs = xi_on_branch(branch, T, sigma, wire)
+    D = youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa)
+    D_eq, x_s = rate_law_modulus(wire, sigma, D)
+    deps = dpath * v / wire.wire_length_m  # Eq. (6): Delta eps = Delta path / L_w
+    return stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma), xi, x_s
+
+
+@njit(cache=True, inline="always")
+def wire_stress_xi(wire, ws, branch, path, stress_law):
+    """(sigma, xi) of a wire at its state: the state's stress (rate law) or the solved one."""
+    if stress_law == StressLaw.ALGEBRAIC:
+        s, xi, _ = algebraic_stress(wire, total_strain(wire, path), ws.T_C, branch)
+        return s, xi
+    return ws.sigma_Pa, xi_on_branch(branch, ws.T_C, ws.sigma_Pa, wire)[0]
+
+
+@njit(cache=True, inline="always")
+def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
+    """A wire's (dT/dt, dsigma/dt, electrical power) and (xi, sigma, spring elongation).
+
+    ``route_now`` = (path, dpath/dq, arm) at the current q; ``wi`` the wire's held inputs.
+    """
+    path, dpath, _ = route_now
+    dT = wire_temperature_rate(wire, ws.T_C, wi.drive, wi.heating, current_drive, opts.joule_heating)
+    if opts.stress_law == StressLaw.ALGEBRAIC:
+        sigma, xi, x_s = algebraic_stress(wire, total_strain(wire, path), ws.T_C, wi.branch)
+        dsigma = 0.0
+    else:
+        sigma = ws.sigma_Pa
+        dsigma, xi, x_s = rate_law(wire, sigma, ws.T_C, dT, wi.branch, dpath, v)
+    return dT, dsigma, sigma, xi, x_s

@@ -1,0 +1,103 @@
+"""Parameter files (TOML): one set per file, written and read back exactly.
+
+A file names its mechanism (``mechanism = "joint"``; the default, for files written by
+smafinger 0.1) and either gives every parameter or starts from a named set
+(``base = "paper2010"``) and overrides some. Model options go in an ``[options]`` table (top-level
+option keys, as smafinger 0.1 wrote them, are read too).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import fields
+from pathlib import Path
+from typing import Any, Callable
+
+from .base import ParameterError, ParameterSet
+from .mechanisms import MECHANISMS
+from .options import OPTION_NAMES, ModelOptions
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return repr(float(v))
+
+
+def to_toml(p: ParameterSet) -> str:
+    """The set as TOML, every value with its doc as a comment."""
+    lines = ["# smafinger parameter set (SI units; unit in each name)",
+             f"mechanism = {_toml_value(p.mechanism)}"]
+    for f in fields(p):
+        if f.name == "options":
+            continue
+        lines.append(f"{f.name} = {_toml_value(getattr(p, f.name))}  # {f.metadata.get('doc', '')}".rstrip(" #"))
+    lines += ["", "[options]"]
+    for f in fields(p.options):
+        v = getattr(p.options, f.name)
+        lines.append(f"{f.name} = {_toml_value(v if isinstance(v, bool) else v.label)}  # {f.metadata['doc']}")
+    return "\n".join(lines) + "\n"
+
+
+def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+    """Load a parameter file (see the module docstring)."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ParameterError(f"parameter file not found: {path}") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise ParameterError(f"parameter file {path}: cannot be read ({type(exc).__name__})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError(f"{path}: not valid TOML ({exc})") from None
+    try:
+        return _from_dict(data, registry_get)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from None
+
+
+def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+    data = dict(data)
+    base_name = data.pop("base", None)
+    options = data.pop("options", {})
+    if not isinstance(options, dict):
+        raise ParameterError("options must be a table ([options])")
+    options.update({k: data.pop(k) for k in list(data) if k in OPTION_NAMES})
+    label = data.pop("mechanism", None)
+    if base_name is not None:
+        base = registry_get(base_name)
+        if label is not None and label != base.mechanism:
+            raise ParameterError(f"mechanism = {label!r} but base {base_name!r} is a {base.mechanism} set")
+        return base.replace(**data, **options)
+    label = label or "joint"
+    if label not in MECHANISMS:
+        raise ParameterError(f"mechanism = {label!r} is not one of {', '.join(MECHANISMS)}")
+    cls = MECHANISMS[label]
+    names = cls.field_names()
+    unknown = sorted(set(data) - set(names))
+    if unknown:
+        raise ParameterError(f"unknown parameter(s) for a {label} set: {', '.join(unknown)}")
+    missing = [m for m in sorted(set(names) - set(data)) if _required(cls, m)]
+    if missing:
+        raise ParameterError(f"missing parameter(s) {', '.join(missing)} (or give base = \"NAME\" of a named set)")
+    unknown_opt = sorted(set(options) - set(OPTION_NAMES))
+    if unknown_opt:
+        raise ParameterError(f"unknown option(s): {', '.join(unknown_opt)}")
+    missing_opt = sorted(set(OPTION_NAMES) - set(options))
+    if missing_opt:
+        raise ParameterError(f"missing option(s) {', '.join(missing_opt)} (or give base = \"NAME\" of a named set)")
+    data.setdefault("name", "custom")
+    data.setdefault("source", "user parameter file")
+    return cls(**data, options=ModelOptions(**options))
+
+
+def _required(cls: type, name: str) -> bool:
+    """A field with no default (``name`` and ``source`` get placeholders when missing)."""
+    import dataclasses
+
+    if name in ("name", "source"):
+        return False
+    f = next(f for f in fields(cls) if f.name == name)
+    return f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
