@@ -9,9 +9,11 @@ MATLAB with :func:`write_mat`. Layouts, mapping syntax and refusals: ``docs/reco
 from .mapping import MappingError, SignalMap, Source, parse_map_options
 from .reader import read_recording
 from .recording import Recording, Series
+from .resample import OutputSamples, input_on_grid, input_program, output_on_grid
 from .signals import SIGNALS, RecordingError, SignalSpec
 
 __all__ = [
     "read_recording", "Recording", "Series", "RecordingError", "MappingError", "SignalMap", "Source",
-    "parse_map_options", "SIGNALS", "SignalSpec",
+    "parse_map_options", "input_on_grid", "output_on_grid", "OutputSamples", "input_program",
+    "SIGNALS", "SignalSpec",
 ]
