@@ -7,6 +7,7 @@ MATLAB with :func:`write_mat`. Layouts, mapping syntax and refusals: ``docs/reco
 """
 
 from .mapping import MappingError, SignalMap, Source, parse_map_options
+from .matwrite import matlab_name, write_mat
 from .reader import read_recording
 from .recording import Recording, Series
 from .resample import OutputSamples, input_on_grid, input_program, output_on_grid
@@ -15,5 +16,5 @@ from .signals import SIGNALS, RecordingError, SignalSpec
 __all__ = [
     "read_recording", "Recording", "Series", "RecordingError", "MappingError", "SignalMap", "Source",
     "parse_map_options", "input_on_grid", "output_on_grid", "OutputSamples", "input_program",
-    "SIGNALS", "SignalSpec",
+    "write_mat", "matlab_name", "SIGNALS", "SignalSpec",
 ]
