@@ -108,6 +108,18 @@ def test_recording_arrays_are_read_only(tmp_path):
         rec.meta["format"] = "x"
 
 
+def test_csv_from_excel_bom_crlf_quotes_spaces_and_blank_lines(tmp_path):
+    f = tmp_path / "excel.csv"
+    f.write_bytes(b'\xef\xbb\xbf"t_s", duty ,theta_deg\r\n0,0.5,-40\r\n0.001, 0.5 ,\r\n\r\n0.002,0.25,-39.5\r\n'
+                  b'0.003,0.25,x\r\n')
+    msg = refusal(f)
+    assert "column 'theta_deg', data row 5 (line 6): 'x' is not a number" in msg  # the blank line counts
+    f.write_bytes(f.read_bytes().replace(b"0.003,0.25,x\r\n", b""))
+    rec = read_recording(f)
+    assert rec.input.t_s.tolist() == [0.0, 0.001, 0.002] and rec.input.values.tolist() == [0.5, 0.5, 0.25]
+    assert rec.output.t_s.tolist() == [0.0, 0.002]
+
+
 # ---- Parquet ----------------------------------------------------------------------------------
 def test_parquet_nulls_are_missing_samples(tmp_path):
     n = 50
@@ -132,6 +144,18 @@ def test_parquet_nan_is_refused_with_its_row(tmp_path):
     pq.write_table(pa.table({"t_s": np.arange(8.0), "duty": np.full(8, 0.3), "position_m": pos}), f)
     msg = refusal(f)
     assert "column 'position_m', row 6" in msg and "nan" in msg
+
+
+def test_parquet_time_in_ms_and_a_repeated_time(tmp_path):
+    f = tmp_path / "ms.parquet"
+    pd.DataFrame({"ms": [0, 5, 10, 10, 20], "voltage_V": [0.0, 8, 8, 8, 0], "theta_deg": [-40.0] * 5}).to_parquet(f)
+    msg = refusal(f, {"t_s": "ms*1e-3"})
+    assert "column 'ms', row 4: time repeats (0.01 s after 0.01 s)" in msg
+    pd.DataFrame({"ms": [0, 5, 10, 15], "voltage_V": [0.0, 8, 8, 0], "theta_deg": [-40.0] * 4}).to_parquet(f)
+    assert read_recording(f, {"t_s": "ms/1000"}).input.t_s.tolist() == [0.0, 0.005, 0.01, 0.015]
+    pd.DataFrame({"t_s": [0.0, 1.0], "duty": ["a", "b"], "theta_deg": [0.0, 0.0]}).to_parquet(f)
+    msg = refusal(f)
+    assert "column 'duty' holds " in msg and "string, not numbers" in msg
 
 
 # ---- MATLAB ----------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from .mapping import SignalMap, as_signal_map
 from .recording import Recording, Series
-from .signals import EXTRAS, INPUTS, OUTPUTS, SPEC, RecordingError, check_signal
+from .signals import EXTRAS, INPUTS, OUTPUTS, SPEC, TIME, RecordingError, check_signal
 
 #: file suffix (lower case) -> format
 FORMATS = {".csv": "csv", ".parquet": "parquet", ".pq": "parquet", ".mat": "mat"}
@@ -79,7 +79,7 @@ def _choose(source_file, smap: SignalMap) -> dict[str, str]:
     what, path = source_file.what, source_file.path
     listing = ", ".join(map(repr, source_file.names)) or "none"
     for name, src in smap.entries:
-        if name != "t_s" and src.name not in names:
+        if name != TIME and src.name not in names:
             raise RecordingError(f"{path}: mapping {name}={src.to_text()}: no {what} {src.name!r} "
                                  f"({what}s: {listing})")
     chosen = {}
