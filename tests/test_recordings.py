@@ -387,6 +387,19 @@ def test_missing_file_and_directory_are_refused(tmp_path):
     assert "not a file" in refusal(tmp_path / "dir.csv")
 
 
+@pytest.mark.parametrize("compress", [False, True])
+def test_truncated_mat_files_are_refused(tmp_path, compress):
+    t = np.arange(100.0)
+    whole = tmp_path / "whole.mat"
+    sio.savemat(whole, {"duty": simulink(t, np.full(100, 0.1)), "theta_deg": simulink(t, -40 + 0 * t)},
+                do_compression=compress)
+    data = whole.read_bytes()
+    for cut in range(0, len(data) - 1, max(1, len(data) // 40)):
+        f = tmp_path / f"cut{cut}.mat"
+        f.write_bytes(data[:cut])
+        refusal(f)
+
+
 MAT_CASES = [
     # (variables, mapping, fragments)
     ({"duty": {"time": np.zeros((0, 0)), "signals": {"values": np.ones((5, 1))}},

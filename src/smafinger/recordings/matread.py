@@ -62,14 +62,18 @@ def open_mat(path, smap: SignalMap) -> MatFile:
         If the file is not a MATLAB file scipy can read (a v7.3 file gets the hint to save
         with ``-v7``).
     """
+    import zlib
+
     from scipy.io import loadmat
+    from scipy.io.matlab import MatReadError
 
     try:
         data = loadmat(path, squeeze_me=False, struct_as_record=False, chars_as_strings=True)
     except NotImplementedError:
         raise RecordingError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read; "
                              f"save it with save(..., '-v7')") from None
-    except Exception as exc:  # scipy raises ValueError, TypeError, MatReadError, ... on bad files
+    except (MatReadError, ValueError, TypeError, IndexError, KeyError, EOFError, OSError, zlib.error) as exc:
+        # what scipy raises on a file that is not a MAT-file, or is truncated or corrupt
         raise RecordingError(f"{path}: not a readable MATLAB file ({' '.join(str(exc).split())})") from None
     variables = {k: v for k, v in data.items() if not k.startswith("__")}
     header = data.get("__header__", b"")
