@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from smafinger.engine import batch, pools
+from smafinger.engine import batch, dask_pool, pools
 from smafinger.engine.batch import BatchError, DistributedMissing, run_batch, specs_product
 from smafinger.engine.run import make_spec, run_spec
 from smafinger.parameters import get
@@ -160,7 +160,7 @@ def test_bad_scheduler_addresses_are_refused_at_once(address, message):
 
 
 def test_scheduler_address_parsing():
-    parse = pools.parse_scheduler_address
+    parse = dask_pool.parse_scheduler_address
     assert parse("tcp://10.0.0.1:8786") == ("tcp", "10.0.0.1", 8786)
     assert parse("localhost:8786") == ("tcp", "localhost", 8786)
     assert parse("tls://[::1]:9000") == ("tls", "::1", 9000)

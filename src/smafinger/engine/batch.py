@@ -30,9 +30,9 @@ from typing import Any, Callable, Iterable, Iterator, Sequence
 
 import numpy as np
 
-from .pools import (CONNECT_TIMEOUT_S, BatchError, DaskPool, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
-                    SerialPool, Task, available_cores, build_spec, check_scheduler, is_warm, make_pool,
-                    run_chunk, warm_up)
+from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itself is imported on use)
+from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
+                    SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, warm_up)
 from .run import RunSpec, make_spec
 
 #: signals kept in float64 by :func:`compact_signals`: time is the join key of every trace
@@ -250,9 +250,9 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
 
 def __getattr__(name: str):
     if name == "WarmUpPlugin":  # created on first use (distributed is optional)
-        from . import pools
+        from . import dask_pool
 
-        return pools.WarmUpPlugin
+        return dask_pool.WarmUpPlugin
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
