@@ -32,7 +32,7 @@ How a sweep runs (:func:`run_sweep`):
    files at least every ``save_interval_s``;
 4. the parts are merged into ``OUT`` (and ``OUT.traces``) block by block, and removed.
 
-The client's work per run is small (a few microseconds: see ``benchmarks/bench_scale.py``),
+The client's work per run is small (about 35 us: see ``benchmarks/bench_scale.py``),
 so it keeps a large cluster busy.
 """
 
