@@ -3,7 +3,18 @@
 1. Parallel vs serial: the Fig. 8 sweep's runs (``examples/sweep-fig8.toml``, 231 runs)
    in this process one after the other, and on a pool of worker processes (one per core),
    each run reduced to its table row in the worker. Goal: >= 1.8x on 2 cores.
-2. Engine vs a straightforward SciPy ``solve_ivp`` implementation of the same model
+2. Lean batches (issue 11), each in a fresh child process so that its peak memory
+   (``ru_maxrss``) is the client's alone:
+   a. 1,000 full-cycle runs (Fig. 15's co-operative -40 -> -25 -> -55 -> -40 deg cycle,
+      60 s simulated, K_P varied) as a sweep on every core: wall time, client peak memory.
+      Goal: <= 5 s and < 1 GB on 2 cores.
+   b. 100 runs of 20 s at 1 ms returning results: full ``SimulationResult`` objects
+      (``run_batch``) against :class:`~smafinger.engine.batch.Compact` (all signals, float32)
+      and against streaming them with ``iter_batch`` (each written away as it comes).
+3. The client's own cost per run in a sweep (chunks made and sent, rows received and
+   saved), measured with the simulations replaced by their recorded rows: how many
+   workers one client keeps busy (goal: >= 0.8 x the cores of the cluster).
+4. Engine vs a straightforward SciPy ``solve_ivp`` implementation of the same model
    (``benchmarks/scipy_baseline.py``: plain-Python right-hand side) on the same case: the
    upper wire at 8 V for 6 s, then off, to 20 s (``voltage="0:8:0,6:0:0"``, parameter set
    ``paper2010`` with ``minor_loop_reversal_C = 0``, the branch rule the baseline
@@ -14,13 +25,20 @@
 Usage::
 
     PYTHONPATH=src python benchmarks/bench_scale.py [--repeat 3] [--quick]
+
+``--quick`` skips the PWM SciPy case and runs 200 instead of 1,000 full cycles.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import pickle
 import statistics
+import subprocess
 import sys
+import tempfile
 import time
 from functools import partial
 from pathlib import Path
@@ -107,7 +125,7 @@ def bench_scipy(repeat: int, quick: bool) -> dict:
         pwm = ",".join(f"{k * 1e-3:.4f}:8:0,{k * 1e-3 + 8e-4:.4f}:0:0" for k in range(8000)) + ",8:0:0"
         cases.append(("PWM 80 % duty, 1 ms, for 8 s", pwm))
     for name, voltage in cases:
-        print(f"\n[2] engine vs scipy solve_ivp, open loop, {name}, paper2010, 20 s")
+        print(f"\n[4] engine vs scipy solve_ivp, open loop, {name}, paper2010, 20 s")
         eng_s, kern_s, t, th_eng = _engine_case(p, voltage, repeat * 2)
         t_ref, th_ref, info_ref = scipy_baseline.simulate_baseline(p, voltage, method="LSODA", rtol=1e-10)
         assert np.allclose(t, t_ref)
@@ -133,6 +151,127 @@ def bench_scipy(repeat: int, quick: bool) -> dict:
     return out
 
 
+
+# ---------------------------------------------------------------------------------------
+# [2] lean batches, each in a child process (its ru_maxrss is the client's peak alone)
+# ---------------------------------------------------------------------------------------
+_CHILD = r"""
+import json, resource, sys, time
+from pathlib import Path
+sys.path.insert(0, {src!r})
+def main():
+    case, n, tmp = sys.argv[1], int(sys.argv[2]), Path(sys.argv[3])
+    from smafinger.engine import batch
+    from smafinger.engine.run import make_spec
+    t0 = time.perf_counter()
+    extra = {{}}
+    if case == "sweep":
+        from smafinger.analysis.sweep import parse_spec, run_sweep
+        spec = parse_spec({{"base": {{"scenario": "fig15-cooperative-v1"}},
+                           "vary": {{"K_P_per_rad": {{"start": 2000.0, "stop": 4000.0, "num": n}}}}}})
+        rep = run_sweep(spec, tmp / "cycle.parquet")
+        extra = {{"failed": rep.failed_total, "client_ms_per_run": 1e3 * rep.client_s_per_run}}
+    else:
+        from smafinger.parameters import get
+        t2 = get("paper2010-table2")
+        specs = [make_spec(t2.replace(h0_heating_W_m2K=60.0 + i * 0.01), "open-loop", voltage="0:8:0,8:0:0",
+                           t_end_s=20.0) for i in range(n)]
+        if case == "full":
+            out = batch.run_batch(specs)
+            extra = {{"held_MB": sum(r.to_pandas().memory_usage().sum() for r in out[:1]) * n / 1e6}}
+        elif case == "compact":
+            out = batch.run_batch(specs, reduce=batch.Compact())
+            extra = {{"held_MB": sum(r.nbytes for r in out) / 1e6}}
+        else:  # stream: each compact result written away as it comes
+            import pyarrow as pa, pyarrow.parquet as pq
+            w = None
+            for i, ok, r in batch.iter_batch(specs, reduce=batch.Compact()):
+                t = pa.table(r.signals)
+                w = w or pq.ParquetWriter(str(tmp / "stream.parquet"), t.schema)
+                w.write_table(t)
+            w.close()
+            extra = {{"written_MB": (tmp / "stream.parquet").stat().st_size / 1e6}}
+    wall = time.perf_counter() - t0
+    print(json.dumps({{"wall_s": wall, "peak_MB": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+                      **extra}}))
+if __name__ == "__main__":
+    main()
+"""
+
+
+def _child(case: str, n: int) -> dict:
+    with tempfile.TemporaryDirectory() as d:
+        script = Path(d) / "child.py"
+        script.write_text(_CHILD.format(src=str(HERE.parent / "src")))
+        r = subprocess.run([sys.executable, str(script), case, str(n), d], capture_output=True, text=True)
+    if r.returncode:
+        raise RuntimeError(f"child {case} failed:\n{r.stderr[-2000:]}")
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def bench_lean(quick: bool) -> dict:
+    n_cycle = 200 if quick else 1000
+    print(f"\n[2a] {n_cycle} full-cycle runs (Fig. 15 co-operative, 60 s simulated) as a sweep on "
+          f"{batch.available_cores()} cores")
+    cyc = _child("sweep", n_cycle)
+    per_run = cyc["wall_s"] / n_cycle
+    print(f"    wall {cyc['wall_s']:.1f} s ({1e3 * per_run:.1f} ms per run, pool start and check pass included); "
+          f"client peak {cyc['peak_MB']:.0f} MB; failed {cyc['failed']}; client {cyc['client_ms_per_run']:.3f} ms/run "
+          f"in the loop  (goal: 1,000 in <= 5 s, < 1 GB)")
+    print("\n[2b] 100 runs of 20 s at 1 ms, results returned (peak memory of the client)")
+    out = {"cycle": cyc}
+    for case, label in (("full", "run_batch, full SimulationResults"), ("compact", "run_batch, Compact() float32"),
+                        ("stream", "iter_batch + Compact(), streamed to parquet")):
+        r = _child(case, 100)
+        out[case] = r
+        held = f"; results held {r['held_MB']:.0f} MB" if "held_MB" in r else f"; {r['written_MB']:.0f} MB written"
+        print(f"    {label:45s}: peak {r['peak_MB']:6.0f} MB, {r['wall_s']:.1f} s{held}")
+    print(f"    RATIO peak full / compact: {out['full']['peak_MB'] / out['compact']['peak_MB']:.2f}x, "
+          f"full / streamed: {out['full']['peak_MB'] / out['stream']['peak_MB']:.2f}x")
+    return out
+
+
+# ---------------------------------------------------------------------------------------
+# [3] the client's cost per run, simulations replaced by recorded rows
+# ---------------------------------------------------------------------------------------
+def bench_client(repeat: int, n: int = 20000) -> dict:
+    from smafinger.analysis import sweep as sw
+    from smafinger.analysis.sweep_rows import run_block
+
+    spec = sw.parse_spec({"base": {"params": "paper2010-table2", "strategy": "open-loop",
+                                   "voltage": "0:8:0,8:0:0", "t_end_s": 20.0},
+                          "vary": {"h0_heating_W_m2K": {"start": 60.0, "stop": 70.0, "num": n}}})
+    template, points = spec.template(), spec.point_source()
+    first = {"h0_heating_W_m2K": [60.0]}
+    real = run_block(template, [0], [sw.run_id(template.build({"h0_heating_W_m2K": 60.0}))], first)
+    row = real.rows[0]
+    ids = np.array([f"{i:016x}".encode() for i in range(n)], dtype="S16")
+    todo = np.ones(n, dtype=bool)
+    size = batch.auto_chunk_size(n, 64)  # as for a 64-worker cluster
+    ts = []
+    for _ in range(repeat):
+        with tempfile.TemporaryDirectory() as d:
+            saver = sw._Saver(Path(d) / "x.parquet.parts", 1.0, False)
+            t0 = time.perf_counter()
+            for item in sw._run_items(template, points, ids, todo, size):
+                pickle.loads(pickle.dumps(item))                      # the task goes out
+                rows = [dict(row, run_id=i, point=p) for p, i in zip(item[1], item[2])]
+                block = pickle.loads(pickle.dumps(type(real)(rows, None, 0)))  # its rows come back
+                saver.add(block)
+            saver.flush()
+            ts.append((time.perf_counter() - t0) / n)
+    c = statistics.median(ts)
+    print(f"\n[3] the client's own work per run ({n} runs, chunks of {size}, rows saved as parts every 1 s)")
+    print(f"    {1e6 * c:.1f} us per run (median of {repeat}; min {1e6 * min(ts):.1f})")
+    res = {"client_s": c}
+    for label, run_s in (("Fig. 8 run, 20 s open loop", 0.007), ("full cycle, 60 s co-operative", 0.060)):
+        busy = run_s / c
+        print(f"    {label} ({1e3 * run_s:.0f} ms of work): one client keeps {busy:,.0f} workers busy "
+              f"(a 64-core cluster at {min(1.0, busy / 64):.2f} x its cores; goal >= 0.8)")
+        res[label] = busy
+    return res
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="repetitions per timing (median)")
@@ -144,9 +283,18 @@ def main() -> None:
     print(f"smafinger scale benchmarks: python {platform.python_version()}, {os.cpu_count()} cpus, "
           f"load average {os.getloadavg()[0]:.2f} at start")
     par = bench_parallel(a.repeat)
+    lean = bench_lean(a.quick)
+    cli = bench_client(a.repeat)
     sci = bench_scipy(a.repeat, a.quick)
     print("\nsummary")
     print(f"    parallel vs serial            : {par['ratio']:.2f}x warm, {par['cold']:.2f}x with pool start (goal >= 1.8x)")
+    cyc = lean["cycle"]
+    print(f"    full cycles as a sweep        : {cyc['wall_s']:.1f} s, client peak {cyc['peak_MB']:.0f} MB "
+          f"(goal 1,000 in <= 5 s, < 1 GB)")
+    print(f"    100 x 20 s results, peak      : full {lean['full']['peak_MB']:.0f} MB, compact "
+          f"{lean['compact']['peak_MB']:.0f} MB, streamed {lean['stream']['peak_MB']:.0f} MB")
+    print(f"    client per run                : {1e6 * cli['client_s']:.1f} us: keeps "
+          f"{cli['Fig. 8 run, 20 s open loop']:,.0f} workers busy at 7 ms per run (goal >= 0.8 x cores)")
     for name, r in sci.items():
         best = {f"{m} rtol {rt:g}": (ratio, err) for m, rt, _, err, ratio in r["baselines"]}
         shown = "; ".join(f"{k}: {v[0]:.1f}x (its error {v[1]:.4f} deg)" for k, v in best.items())

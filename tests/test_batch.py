@@ -5,9 +5,11 @@ from __future__ import annotations
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
+from hypothesis import given, settings, strategies as st
 
-from smafinger.engine import batch
+from smafinger.engine import batch, dask_pool, pools
 from smafinger.engine.batch import BatchError, DistributedMissing, run_batch, specs_product
 from smafinger.engine.run import make_spec, run_spec
 from smafinger.parameters import get
@@ -44,9 +46,11 @@ def test_parallel_results_bit_identical_to_single_runs():
     assert len(together) == len(specs)
     for a, b in zip(alone, together):
         assert b.spec == a.spec  # input order kept
-        assert a.to_pandas().equals(b.to_pandas())
+        pd.testing.assert_frame_equal(a.to_pandas(), b.to_pandas(), check_exact=True)
         assert np.array_equal(a.segment_start_s, b.segment_start_s)
+        assert np.array_equal(a.segment_reached_s, b.segment_reached_s, equal_nan=True)
         assert (a.substeps, a.interlock_violations) == (b.substeps, b.interlock_violations)
+        assert _summary(a) == _summary(b)
 
 
 def test_reduce_in_workers_serial_and_pool_agree():
@@ -69,6 +73,8 @@ def test_dict_items_and_errors():
         run_batch(items, workers=1, reduce=_boom)
     with pytest.raises(TypeError, match="RunSpec or a dict"):
         run_batch([42])
+    [(i, ok, exc)] = list(batch.iter_batch([object()], workers=1))  # iter_batch: checked in the worker
+    assert (i, ok) == (0, False) and "a RunSpec or a recipe with build()" in str(exc)
     with pytest.raises(ValueError, match="errors"):
         run_batch(items, errors="ignore")
     with pytest.raises(ValueError, match="workers"):
@@ -91,3 +97,73 @@ def test_dask_is_optional(monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     with pytest.raises(DistributedMissing, match=r"pip install 'smafinger\[distributed\]'"):
         batch.make_pool(scheduler="tcp://127.0.0.1:8786")
+
+
+def _counting(specs, drawn):
+    for s in specs:
+        drawn.append(s)
+        yield s
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_iter_batch_draws_runs_lazily(workers):
+    """Only a few chunks per worker are drawn ahead of the results (bounded memory)."""
+    spec = make_spec("paper2010", "cooperative", "0:-30", t_end_s=0.2)
+    drawn: list = []
+    seen = []
+    with batch.make_pool(workers) as pool:
+        for i, ok, value in batch.iter_batch(_counting([spec] * 40, drawn), pool=pool, chunk_size=2,
+                                             reduce=_summary):
+            assert ok
+            if not seen:
+                ahead = len(drawn)
+            seen.append(i)
+    assert sorted(seen) == list(range(40))
+    assert ahead <= 2 * pools.IN_FLIGHT_PER_SLOT * pool.slots + 2  # not the 40 of the batch
+    assert len(drawn) == 40
+
+
+def test_compact_results_float32_decimated():
+    spec = make_spec("paper2010", "cooperative", "0:-25,1:-45", t_end_s=2.0)
+    full = run_spec(spec)
+    [c] = run_batch([spec], workers=1, reduce=batch.Compact(("t_s", "theta_deg", "T_upper_C"), every=10))
+    assert c.signal("t_s").dtype == np.float64 and c.signal("theta_deg").dtype == np.float32
+    assert np.array_equal(c.signal("t_s"), full.signal("t_s")[::10])
+    assert np.array_equal(c.signal("theta_deg"), full.signal("theta_deg")[::10].astype(np.float32))
+    # float32 loses nothing that matters: well below the model's 0.015 deg accuracy
+    assert np.max(np.abs(c.signal("theta_deg") - full.signal("theta_deg")[::10])) < 1e-4
+    assert c.summary == full.summary() | {"wall_s": c.summary["wall_s"]}  # metrics at full resolution
+    assert c.nbytes == 201 * (8 + 4 + 4)
+    with pytest.raises(KeyError, match="signal 'xi_upper' was not kept"):
+        c.signal("xi_upper")
+    with pytest.raises(ValueError, match="every = 0"):
+        batch.Compact(every=0)
+    everything = batch.Compact()(full)
+    assert set(everything.signals) == set(full.to_pandas().columns)
+
+
+@given(n=st.integers(0, 50), size=st.integers(1, 12))
+@settings(max_examples=50, deadline=None)
+def test_chunked_is_lazy_and_complete(n, size):
+    chunks = list(batch.chunked(iter(range(n)), size))
+    assert [x for c in chunks for x in c] == list(range(n))
+    assert all(len(c) == size for c in chunks[:-1]) and (not chunks or 1 <= len(chunks[-1]) <= size)
+
+
+@pytest.mark.parametrize("address, message", [
+    ("tcp://127.0.0.1:99999", r"port '99999' is not a number in 1..65535"),
+    ("tcp://127.0.0.1:http", r"port 'http' is not a number"),
+    ("tcp://:8786", "the host is missing"),
+    ("tcp://host:1/path", "expected an address like tcp://HOST:PORT"),
+])
+def test_bad_scheduler_addresses_are_refused_at_once(address, message):
+    with pytest.raises(batch.SchedulerError, match=message):
+        batch.check_scheduler(address, 5.0)
+
+
+def test_scheduler_address_parsing():
+    parse = dask_pool.parse_scheduler_address
+    assert parse("tcp://10.0.0.1:8786") == ("tcp", "10.0.0.1", 8786)
+    assert parse("localhost:8786") == ("tcp", "localhost", 8786)
+    assert parse("tls://[::1]:9000") == ("tls", "::1", 9000)
+    assert parse("tcp://sched") == ("tcp", "sched", None)

@@ -5,6 +5,10 @@ from __future__ import annotations
 import logging
 import os
 import signal
+import socket
+import sys
+import threading
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -19,6 +23,7 @@ from smafinger.engine import batch  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 FIG8 = ROOT / "examples" / "sweep-fig8.toml"
 SRC = Path(sw.__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parent))  # test_sweep's helpers
 
 
 @pytest.fixture(scope="module")
@@ -86,5 +91,68 @@ def test_worker_killed_mid_sweep_still_completes(cluster, tmp_path):
 
 
 def test_unreachable_scheduler_is_a_clear_error():
-    with pytest.raises(batch.BatchError, match="cannot connect to the Dask scheduler at tcp://127.0.0.1:9"):
+    with pytest.raises(batch.SchedulerError, match="cannot connect to the Dask scheduler at tcp://127.0.0.1:9: "):
         batch.DaskPool("tcp://127.0.0.1:9", timeout_s=1.0)
+
+
+@pytest.fixture
+def silent_port():
+    """A loopback port that accepts TCP connections and never says a word."""
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(8)
+    conns, stop = [], threading.Event()
+
+    def accept():
+        srv.settimeout(0.1)
+        while not stop.is_set():
+            try:
+                conns.append(srv.accept()[0])
+            except OSError:
+                pass
+
+    th = threading.Thread(target=accept, daemon=True)
+    th.start()
+    try:
+        yield srv.getsockname()[1]
+    finally:
+        stop.set()
+        th.join(5)
+        for c in conns:
+            c.close()
+        srv.close()
+
+
+def test_a_port_that_is_not_a_scheduler_fails_within_the_timeout(silent_port):
+    t0 = time.monotonic()
+    with pytest.raises(batch.SchedulerError, match=rf"tcp://127.0.0.1:{silent_port} accepts connections but is not "
+                                                   r"a Dask scheduler \(no answer within 1 s; see --connect-timeout\)"):
+        batch.DaskPool(f"tcp://127.0.0.1:{silent_port}", timeout_s=1.0)
+    assert time.monotonic() - t0 < 30  # (it used to hang for ever)
+
+
+@pytest.mark.parametrize("address, message", [
+    ("tcp://127.0.0.1:99999", "port '99999' is not a number in 1..65535"),
+    ("tcp://127.0.0.1:9", "cannot connect to the Dask scheduler at tcp://127.0.0.1:9"),
+    ("SILENT", "accepts connections but is not a Dask scheduler"),
+])
+def test_cli_bad_scheduler_is_one_line_and_exit_2(tmp_path, silent_port, address, message):
+    from test_sweep import SMALL, _cli, _write
+
+    spec = _write(tmp_path, SMALL)
+    address = address.replace("SILENT", f"tcp://127.0.0.1:{silent_port}")
+    r = _cli([str(spec), "--scheduler", address, "--connect-timeout", "1"], tmp_path)
+    assert r.exit_code == 2, r.output
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("smafinger: error: ") and message in lines[0], r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["spec.toml"]
+
+
+def test_worker_count_is_read_live(cluster):
+    pool = batch.DaskPool(cluster.scheduler_address)
+    try:
+        assert pool.slots == 2 and "(2 worker threads)" in pool.describe()
+        pool._slots_at = -1e9  # as if a second had passed
+        assert pool.slots == sum(pool.client.nthreads().values())
+    finally:
+        pool.close()

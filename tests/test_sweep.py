@@ -10,11 +10,13 @@ import time
 from pathlib import Path
 
 import numpy as np
+from hypothesis import given, settings, strategies as st
 import pandas as pd
 import pytest
 
 from smafinger.analysis import sweep as sw
-from smafinger.analysis.sweep import SweepInterrupted, SweepSpecError, load_spec, parse_spec, run_sweep
+from smafinger.analysis.sweep import (SweepInterrupted, SweepSizeError, SweepSpecError, load_spec, parse_spec,
+                                     run_sweep)
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG8 = ROOT / "examples" / "sweep-fig8.toml"
@@ -215,7 +217,7 @@ def test_killed_sweep_resumes_every_run_once(tmp_path):
     """SIGKILL a running `smafinger sweep` after some parts are written; rerun; every run once."""
     vary = '[vary]\nh0 = {fields = ["h0_heating_W_m2K", "h0_cooling_W_m2K"], start = 60.0, stop = 70.0, num = 40}\n' \
            'h2_heating_W_m2K3 = [5e-4, 1e-3]\n'
-    spec = _write(tmp_path, _spec(vary, "chunk_size = 2", t_end=10.0))
+    spec = _write(tmp_path, _spec(vary, "chunk_size = 2\nsave_interval_s = 0", t_end=10.0))
     out = tmp_path / "res.parquet"
     parts = sw.parts_dir(out)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
@@ -272,6 +274,9 @@ def test_traces_option(tmp_path):
     df = pd.read_parquet(out)
     assert rep.traces_out == tmp_path / "res.traces.parquet"
     assert set(tr["run_id"]) == set(df["run_id"])
+    assert tr["point"].is_monotonic_increasing and set(tr["point"]) == set(df["point"])
+    # compact: float32 signals, float64 time (the join key)
+    assert tr["t_s"].dtype == np.float64 and tr["theta_deg"].dtype == np.float32
     one = tr[tr["run_id"] == df.loc[0, "run_id"]]
     assert one["t_s"].tolist() == [0.0, 0.5, 1.0, 1.5, 2.0]
     assert np.isclose(one["theta_deg"].max(), df.loc[0, "theta_max_deg"], atol=0.5)
@@ -335,3 +340,224 @@ def test_cli(tmp_path):
     r = _cli([str(spec), "--out", "other.parquet", "--workers", "1"], tmp_path)
     assert r.exit_code == 2 and "is not a smafinger sweep table" in r.output
     assert (tmp_path / "other.parquet").read_bytes() == b"not parquet"
+
+
+# ---- issue 13: reliability ---------------------------------------------------------------
+def _failing(predicate):
+    real = sw.metrics_row
+
+    def row(result, traces_interval_s=None):
+        if predicate(result):
+            raise sw.SimulationError("numerical blow-up (on purpose)")
+        return real(result, traces_interval_s)
+
+    return row
+
+
+@pytest.mark.parametrize("fail, args, code, message", [
+    (lambda r: True, [], 3, "every run failed"),
+    (lambda r: r.spec.params.C_DF_heating_Nms == 0.03, [], 0, "2 of 6 runs failed"),
+    (lambda r: r.spec.params.C_DF_heating_Nms == 0.03, ["--strict"], 3, "2 of 6 runs failed"),
+    (lambda r: False, ["--strict"], 0, None),
+])
+def test_exit_status_says_whether_runs_failed(tmp_path, monkeypatch, fail, args, code, message):
+    monkeypatch.setattr(sw, "metrics_row", _failing(fail))
+    spec = _write(tmp_path, SMALL)
+    r = _cli([str(spec), "--workers", "1", *args], tmp_path)
+    assert r.exit_code == code, r.output
+    assert (tmp_path / "spec.parquet").exists()  # the table is written either way
+    if message:
+        assert message in r.output
+    else:
+        assert "failed (rows" not in r.output
+    # a rerun (everything resumed) says the same
+    assert _cli([str(spec), "--workers", "1", *args], tmp_path).exit_code == code
+
+
+def test_huge_grid_refused_with_its_size_before_anything_is_made(tmp_path):
+    import tracemalloc
+
+    vary = ('[vary]\nh0_heating_W_m2K = {start = 1.0, stop = 100.0, num = 10000}\n'
+            'C_DF_heating_Nms = {start = 0.01, stop = 0.1, num = 10000}\n')
+    p = _write(tmp_path, _spec(vary))
+    tracemalloc.start()
+    try:
+        with pytest.raises(SweepSizeError, match=r"100,000,000 runs \(estimated: table .* GB, client memory .* GB\); "
+                                                 r"that is above the limit of 1,000,000 runs: raise --max-runs"):
+            run_sweep(p, tmp_path / "big.parquet", workers=1)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 20e6  # the two 10,000-value axes, not 10^8 points
+    assert list(tmp_path.iterdir()) == [p]
+    # one name alone with 10^8 values is refused before its values are made
+    with pytest.raises(SweepSpecError, match=r"h0.num: 100,000,000 values: .* above the limit of 1,000,000"):
+        load_spec(_write(tmp_path, _spec('[vary]\nh0 = {fields = ["h0_heating_W_m2K"], start = 1.0, stop = 2.0, '
+                                         'num = 100000000}\n'), "one.toml"))
+    r = _cli([str(p)], tmp_path)
+    assert r.exit_code == 2 and "100,000,000 runs" in r.output
+    assert len([ln for ln in r.output.splitlines() if ln.startswith("smafinger: error:")]) == 1
+    # --max-runs raises the limit
+    assert sw.check_size(load_spec(p, max_runs=10**8), tmp_path / "big.parquet", False, 10**8).runs == 10**8
+
+
+def test_bad_point_and_duplicates_refused_by_the_check_pass(tmp_path):
+    bad = _write(tmp_path, _spec('[vary]\nh0_heating_W_m2K = [60.0, -5.0]\n'))  # spec.toml
+    with pytest.raises(SweepSpecError, match=r"point 1 \(h0_heating_W_m2K = -5.0\): h0_heating_W_m2K = -5.0 is outside"):
+        run_sweep(bad, tmp_path / "bad.parquet", workers=1)
+    dup = _write(tmp_path, _spec('[vary]\nh0_heating_W_m2K = [60.0, 61.0, 60.0]\n'), "dup.toml")
+    with pytest.raises(SweepSpecError, match="points 0 and 2 are the same run"):
+        run_sweep(dup, tmp_path / "dup.parquet", workers=1)
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["dup.toml", "spec.toml"]  # nothing written
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_check_pass_ids_equal_run_ids_made_alone(tmp_path, workers):
+    spec = load_spec(_write(tmp_path, SMALL))
+    from smafinger.engine import batch
+
+    with batch.make_pool(workers) as pool:
+        checked = sw.check_points(spec, spec.template(), spec.point_source(), pool)
+    assert [i.decode() for i in checked.ids.tolist()] == [r.run_id for r in spec.runs()]
+    assert checked.n_segments == 1
+
+
+@given(start=st.integers(0, 40), length=st.integers(0, 40), mode=st.sampled_from(["random", "lhs"]),
+       seed=st.integers(0, 2**32 - 1))
+@settings(max_examples=40, deadline=None)
+def test_lazy_blocks_equal_the_whole_sample(start, length, mode, seed):
+    spec = parse_spec({"base": {"strategy": "cooperative", "profile": "0:-30", "t_end_s": 1.0},
+                       "sweep": {"mode": mode, "samples": 40, "seed": seed},
+                       "vary": {"h0_heating_W_m2K": {"min": 60, "max": 70},
+                                "M_SF_Nm": {"min": 1e-3, "max": 1e-1, "log": True}}})
+    src = spec.point_source()
+    whole = src.block(0, 40)
+    part = src.block(start, start + length)
+    assert part == {k: v[start:start + length] for k, v in whole.items()}
+
+
+def test_grid_blocks_follow_the_product_order(tmp_path):
+    import itertools
+
+    spec = load_spec(_write(tmp_path, SMALL))
+    h0 = spec.vary[0].values
+    cdf = spec.vary[1].values
+    assert spec.points() == [{"h0": a, "C_DF_heating_Nms": b} for a, b in itertools.product(h0, cdf)]
+    assert spec.point_source().block(2, 5) == {"h0": [60.0, 70.0, 70.0], "C_DF_heating_Nms": [0.04, 0.02, 0.03]}
+
+
+def _session_pids(sid: int) -> list[int]:
+    pids = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                stat = (d / "stat").read_text()
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2:].split()
+            if fields[0] != "Z" and int(fields[3]) == sid:  # state, ppid, pgrp, session
+                pids.append(int(d.name))
+    return pids
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc to list a session's processes")
+def test_sigkill_of_the_client_leaves_no_process(tmp_path):
+    """Workers, forkserver and resource tracker all exit within seconds of the client's SIGKILL."""
+    vary = '[vary]\nh0 = {fields = ["h0_heating_W_m2K", "h0_cooling_W_m2K"], start = 60.0, stop = 70.0, num = 200}\n'
+    spec = _write(tmp_path, _spec(vary, "chunk_size = 1\nsave_interval_s = 0", t_end=20.0))
+    out = tmp_path / "res.parquet"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli_sweep", str(spec), "--out", str(out),
+                             "--workers", "2"], env=env, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and proc.poll() is None:
+            if list(sw.parts_dir(out).glob("part-*.parquet")):
+                break
+            time.sleep(0.01)
+        running = _session_pids(proc.pid)
+        assert proc.poll() is None and len(running) >= 4, running  # client, forkserver, tracker, workers
+        os.kill(proc.pid, signal.SIGKILL)  # the client only
+        proc.wait(timeout=10)
+        deadline = time.monotonic() + 10
+        while _session_pids(proc.pid) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert _session_pids(proc.pid) == []
+    finally:
+        for pid in _session_pids(proc.pid):  # never leave them behind, even if the test fails
+            os.kill(pid, signal.SIGKILL)
+
+
+def test_stale_temporaries_are_removed_and_only_ours(tmp_path, monkeypatch):
+    from smafinger.analysis import sweep_store
+
+    spec = _write(tmp_path, SMALL)
+    out = tmp_path / "res.parquet"
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()  # a pid that has exited
+    host = sweep_store._HOST
+    stale = [tmp_path / f".res.parquet.{host}-{dead}.0123abcd.tmp", tmp_path / ".res.parquet.0123456789ab.tmp",
+             tmp_path / f".res.traces.parquet.{host}-{dead}.0123abcd.tmp"]
+    kept = [tmp_path / f".res.parquet.{host}-{os.getpid()}.0123abcd.tmp",  # a live writer
+            tmp_path / f".res.parquet.otherhost-{dead}.0123abcd.tmp",     # another machine's
+            tmp_path / ".res.parquet.abcdef012345.tmp",                    # recent, old-style
+            tmp_path / ".other.parquet.0123456789ab.tmp", tmp_path / "res.parquet.tmp"]
+    for f in stale + kept:
+        f.write_bytes(b"x")
+    old = time.time() - 2 * sweep_store.LEGACY_TMP_AGE_S
+    os.utime(stale[1], (old, old))
+    run_sweep(spec, out, workers=1)
+    assert [f.exists() for f in stale] == [False] * 3
+    assert [f.exists() for f in kept] == [True] * 5
+
+
+def test_parts_and_outputs_are_fsynced(tmp_path, monkeypatch):
+    synced = []
+    real = os.fsync
+
+    def fsync(fd):
+        synced.append(os.readlink(f"/proc/self/fd/{fd}") if Path("/proc/self/fd").exists() else fd)
+        return real(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nsave_interval_s = 0\nchunk_size = 3\n"))
+    run_sweep(spec, tmp_path / "res.parquet", workers=1, traces=True)
+    if Path("/proc/self/fd").exists():
+        names = [Path(s).name for s in synced]
+        assert sum(n.startswith(".part-") and n.endswith(".tmp") for n in names) == 4  # 2 parts x (rows, traces)
+        assert sum(n.startswith(".res.parquet.") for n in names) == 1
+        assert sum(n.startswith(".res.traces.parquet.") for n in names) == 1
+        assert names.count("res.parquet.parts") >= 4 and names.count(tmp_path.name) >= 2  # the folders
+
+
+def test_plain_progress_lines_when_not_a_terminal(tmp_path):
+    import io
+
+    from rich.console import Console
+
+    buf = io.StringIO()
+    console = Console(file=buf, force_terminal=False, width=200)
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nchunk_size = 1\n"))
+    run_sweep(spec, tmp_path / "res.parquet", workers=1, console=console, progress=False,
+              progress_interval_s=1e-9)
+    lines = [ln for ln in buf.getvalue().splitlines() if ln.startswith("sweep spec: ") and "runs (" in ln]
+    assert len(lines) == 6 and lines[-1].startswith("sweep spec: 6/6 runs (100%), 0 failed,")
+    assert all(ln.endswith(", 1 workers") for ln in lines)
+    assert "\x1b[" not in buf.getvalue()  # no terminal codes in a log
+
+
+def test_dashboard_link_is_printed():
+    import io
+
+    from rich.console import Console
+
+    from smafinger.analysis.sweep_progress import Progress
+
+    buf = io.StringIO()
+
+    class Pool:
+        dashboard_link = "http://127.0.0.1:8787/status"
+
+    Progress(Console(file=buf), False, 10.0, "x").pool(Pool())
+    assert buf.getvalue().strip() == "Dask dashboard: http://127.0.0.1:8787/status"

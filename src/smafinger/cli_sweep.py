@@ -2,6 +2,12 @@
 
 Registered by :mod:`smafinger.cli` as ``app.command("sweep")(sweep)``; also runnable alone
 as ``python -m smafinger.cli_sweep SPEC.toml ...``.
+
+Exit status: 0 when the table is written and at least one run succeeded (failed runs are
+rows with ``status = error``, counted on stderr); 3 when every run failed, or with
+``--strict`` when any did; 2 for bad input (one line naming the field or the address,
+nothing written); 1 when the sweep could not complete (a worker pool broke); 130 when
+interrupted (finished runs are saved: run the same command again to resume).
 """
 
 from __future__ import annotations
@@ -13,6 +19,8 @@ from pathlib import Path
 from typing import Optional
 
 import typer
+
+EXIT_RUNS_FAILED = 3
 
 
 def _fail(msg: str, code: int = 2):
@@ -30,51 +38,63 @@ def sweep(
     workers: Optional[int] = typer.Option(None, "--workers", "-w",
                                           help="local worker processes (default: every core; 1: no pool)"),
     scheduler: Optional[str] = typer.Option(None, "--scheduler",
-                                            help="run on this Dask cluster, tcp://HOST:PORT "
+                                            help="run on this Dask cluster, tcp://HOST:PORT: one you trust, "
+                                                 "its workers run pickled code "
                                                  "(needs pip install 'smafinger[distributed]')"),
+    connect_timeout: float = typer.Option(10.0, "--connect-timeout", metavar="SECONDS",
+                                          help="time allowed to reach the Dask scheduler"),
     traces: bool = typer.Option(False, "--traces/--no-traces",
                                 help="also write the runs' sampled signals to FILE.traces.parquet"),
+    max_runs: int = typer.Option(1_000_000, "--max-runs", metavar="N",
+                                 help="refuse sweeps with more runs than this (their size is shown first)"),
+    strict: bool = typer.Option(False, "--strict",
+                                help=f"exit with status {EXIT_RUNS_FAILED} if any run failed (default: only if all did)"),
+    progress_interval: float = typer.Option(10.0, "--progress-interval", metavar="SECONDS",
+                                            help="when stderr is not a terminal: a progress line this often"),
 ):
     """Run many simulations over a grid, a list, or random/Latin-hypercube samples of parameters.
 
     Writes one row per run (run_id, varied values, metrics). Interrupted (Ctrl-C, kill) and run
-    again with the same spec and --out, it skips the runs already finished.
+    again with the same spec and --out, it skips the runs already finished. Exit status: 0 if
+    at least one run succeeded, 3 if all failed (or any, with --strict), 2 for bad input.
     """
     from rich.console import Console
 
     from .analysis.sweep import SweepInterrupted, SweepSpecError, load_spec, run_sweep
-    from .engine.batch import BatchError, DistributedMissing
+    from .engine.batch import BatchError, DistributedMissing, SchedulerError, check_scheduler
 
     if workers is not None and workers < 1:
         _fail(f"--workers {workers}: must be >= 1")
+    if max_runs < 1:
+        _fail(f"--max-runs {max_runs}: must be >= 1")
+    if not progress_interval > 0:
+        _fail(f"--progress-interval {progress_interval}: must be > 0")
     if scheduler is not None:
         if workers is not None:
             _fail("--workers applies to local runs only; with --scheduler the cluster's workers are used")
-        if "://" not in scheduler and ":" not in scheduler:
-            _fail(f"--scheduler {scheduler!r}: expected an address like tcp://HOST:PORT")
         try:
             import distributed  # noqa: F401
         except ImportError:
             _fail("--scheduler needs dask.distributed, which is not installed: pip install 'smafinger[distributed]'")
     try:
-        sweep_spec = load_spec(spec)
-        sweep_spec.runs()  # validate every point before anything runs or is written
-    except SweepSpecError as exc:
+        sweep_spec = load_spec(spec, max_runs=max_runs)
+        if scheduler is not None:
+            scheduler = check_scheduler(scheduler, connect_timeout)  # fail fast, before any work
+    except (SweepSpecError, SchedulerError) as exc:
         _fail(str(exc))
     console = Console(stderr=True)
     previous = _term_as_interrupt()
     try:
         report = run_sweep(sweep_spec, out, workers=workers, scheduler=scheduler, traces=traces,
-                           progress=console.is_terminal, console=console)
+                           progress=console.is_terminal, console=console, max_runs=max_runs,
+                           connect_timeout_s=connect_timeout, progress_interval_s=progress_interval)
     except SweepInterrupted as exc:
         print(f"smafinger: {exc}", file=sys.stderr)
         raise typer.Exit(130)
     except KeyboardInterrupt:
         print("smafinger: interrupted", file=sys.stderr)
         raise typer.Exit(130)
-    except SweepSpecError as exc:
-        _fail(str(exc))
-    except DistributedMissing as exc:
+    except (SweepSpecError, SchedulerError, DistributedMissing) as exc:
         _fail(str(exc))
     except BatchError as exc:
         _fail(str(exc), code=1)
@@ -82,7 +102,13 @@ def sweep(
         _restore_term(previous)
     extra = f" and {report.traces_out}" if report.traces_out else ""
     typer.echo(f"wrote {report.out}{extra}: {report.total} runs ({report.resumed} already done, "
-               f"{report.failed} failed) in {report.wall_s:.1f} s on {report.backend}")
+               f"{report.failed_total} failed) in {report.wall_s:.1f} s on {report.backend}")
+    if report.failed_total:
+        every = report.failed_total == report.total
+        print(f"smafinger: {'every run' if every else f'{report.failed_total} of {report.total} runs'} failed "
+              "(rows with status = error; see their error column)", file=sys.stderr)
+        if every or strict:
+            raise typer.Exit(EXIT_RUNS_FAILED)
 
 
 def _term_as_interrupt():

@@ -19,66 +19,52 @@ A sweep spec (see ``examples/sweep-fig8.toml`` and ``docs/sweeps.md``)::
     stop = 70.0
     num = 21
 
-The table has a row per run: ``run_id`` (a hash of the run's canonical spec: unique, and
-stable across reruns of the same spec), ``point`` (its index in the sweep), the varied
-values, ``status``/``error``, and the run's metrics (see :data:`METRIC_COLUMNS` and the
-per-segment ``seg{i}_*`` columns). Results are written as they finish into
-``OUT.parts/``; a rerun of an interrupted sweep skips the runs already there; at the end the
-parts are consolidated into ``OUT`` (written atomically) and removed.
+How a sweep runs (:func:`run_sweep`):
+
+1. its size is computed (no point is made yet) and a sweep above ``max_runs`` is refused
+   with its size and estimated bytes;
+2. the *check pass*: the workers build and validate every point's spec from the shared
+   :class:`~smafinger.analysis.sweep_spec.SweepTemplate` and return its ``run_id`` (a hash
+   of the run's canonical spec: unique, stable across reruns). A bad point or two points
+   that are the same run refuse the sweep, naming the point, before anything is written;
+3. the runs not already in ``OUT`` or ``OUT.parts/`` go to the workers in chunks, drawn
+   lazily, a few per worker in flight; the rows come back and are saved as durable part
+   files at least every ``save_interval_s``;
+4. the parts are merged into ``OUT`` (and ``OUT.traces``) block by block, and removed.
+
+The client's work per run is small (about 35 us: see ``benchmarks/bench_scale.py``),
+so it keeps a large cluster busy.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import hashlib
-import itertools
 import json
 import math
-import os
+import shutil
 import time
-import tomllib
-import uuid
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
-from ..engine.run import RunSpec, SimulationError, make_spec  # noqa: F401 (SimulationError: re-exported)
-from ..parameters import ParameterError, ParameterSet, resolve
-from ..parameters.base import field_spec
-from ..profiles import ProfileError
+from ..engine import batch
+from ..engine.run import RunSpec, SimulationError  # noqa: F401 (re-exported)
+from .sweep_merge import Finished, write_table, write_traces
+from .sweep_parse import load_spec, parse_spec
+from .sweep_progress import Progress
+from .sweep_rows import (METRIC_COLUMNS, MOTION_THRESHOLD_DEG, TRACE_COLUMNS, check_block, error_row,  # noqa: F401
+                         metrics_row, run_block)
+from .sweep_spec import (DEFAULT_MAX_RUNS, RUN_ID_SCHEMA, Run, SweepSpec, SweepSpecError, Vary,  # noqa: F401
+                         canonical_run, run_id)
+from .sweep_store import IdIndex, StoreError, clean_stale, parts_dir, traces_path, write_part
 
-#: bump when the meaning of a run's canonical spec (and so of run_id) changes
-RUN_ID_SCHEMA = 1
-MODES = ("grid", "list", "random", "lhs")
-#: run settings (make_spec arguments) that a sweep may set in [base] or vary
-RUN_KEYS = {
-    "params": str, "strategy": str, "profile": str, "voltage": str, "t_end_s": float,
-    "dt_s": float, "method": str, "output_interval_s": float, "tol_deg": float,
-    "hold_s": float, "independent_wait": bool,
-}
-BASE_KEYS = set(RUN_KEYS) | {"set", "scenario"}
-SWEEP_KEYS = {"mode", "samples", "seed", "chunk_size", "traces_interval_s", "name"}
-VARY_KEYS = {"fields", "values", "start", "stop", "num", "min", "max", "log"}
-#: the joint has started to move once it is this far from its initial angle
-MOTION_THRESHOLD_DEG = 0.5
-#: per-run metric columns, in table order (then the per-segment ``seg{i}_*`` columns)
-METRIC_COLUMNS = (
-    "status", "error", "energy_upper_J", "energy_lower_J", "peak_T_upper_C", "peak_T_lower_C",
-    "peak_stress_upper_Pa", "peak_stress_lower_Pa", "interlock_violations", "theta_max_deg",
-    "theta_min_deg", "theta_final_deg", "motion_start_s", "steps", "wall_s",
-)
-SEGMENT_COLUMNS = ("target_deg", "start_s", "reached_s", "overshoot_deg")
-TRACE_COLUMNS = ("t_s", "theta_deg", "theta_ref_deg", "omega_deg_s", "T_upper_C", "T_lower_C",
-                 "xi_upper", "xi_lower", "sigma_upper_Pa", "sigma_lower_Pa", "V_upper_V",
-                 "V_lower_V", "duty_upper", "duty_lower")
-_META_KEY = b"smafinger.sweep"
-
-
-class SweepSpecError(ValueError):
-    """The sweep spec is malformed; the message names the field and the value."""
+#: points per task of the check pass (a few ms of work each), and rows per part file at most
+CHECK_BLOCK = 1024
+PART_MAX_ROWS = 4096
+#: sweeps this small are checked in this process (faster than starting a pool)
+CHECK_HERE_MAX = 2000
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -90,598 +76,130 @@ class SweepInterrupted(KeyboardInterrupt):
         self.done, self.total, self.parts = done, total, parts
 
 
-# ---------------------------------------------------------------------------------------
-# the spec
-# ---------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Vary:
-    """One varied name: the fields it sets and its values (or its range, for sampling)."""
-
-    name: str
-    fields: tuple[str, ...]
-    values: tuple | None = None
-    low: float | None = None
-    high: float | None = None
-    log: bool = False
+class SweepSizeError(SweepSpecError):
+    """The sweep is larger than allowed (``max_runs``) or than the free disk space."""
 
 
 @dataclass(frozen=True)
-class Run:
-    point: int
-    run_id: str
-    values: dict
-    spec: RunSpec
+class SweepSize:
+    """A sweep's size, known before anything is made; bytes are uncompressed estimates."""
+
+    runs: int
+    table_bytes: int
+    traces_bytes: int
+    client_bytes: int
+
+    def describe(self) -> str:
+        tr = f", traces {_human(self.traces_bytes)}" if self.traces_bytes else ""
+        return (f"{self.runs:,} runs (estimated: table {_human(self.table_bytes)}{tr}, "
+                f"client memory {_human(self.client_bytes)})")
+
+
+def _human(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB", "TB"):
+        if n < 1000 or unit == "TB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1000
+    return ""  # pragma: no cover
+
+
+def sweep_size(spec: SweepSpec, traces: bool) -> SweepSize:
+    """The size of a sweep and its outputs, from the spec alone (no point is made)."""
+    n = spec.size()
+    profile = spec.base.get("profile")
+    n_seg = profile.count(",") + 1 if isinstance(profile, str) else 1
+    n_cols = 2 + len(spec.vary) + len(METRIC_COLUMNS) + 4 * n_seg
+    samples = math.floor(_max_t_end(spec) / spec.traces_interval_s) + 1
+    per_sample = 8 + 8 + 4 * (len(TRACE_COLUMNS) - 1) + 4  # t_s, point, float32 signals, run_id
+    lhs = 8 * n * len(spec.vary) if spec.mode == "lhs" else 0
+    return SweepSize(n, n * n_cols * 8, n * samples * per_sample if traces else 0, n * 45 + lhs)
+
+
+def check_size(spec: SweepSpec, out: Path, traces: bool, max_runs: int) -> SweepSize:
+    """Refuse (:class:`SweepSizeError`, naming the size) a sweep above ``max_runs`` runs or
+    whose outputs cannot fit in the free space of ``out``'s folder."""
+    size = sweep_size(spec, traces)
+    if size.runs > max_runs:
+        raise SweepSizeError(f"{spec.source}: the sweep has {size.describe()}; that is above the limit of "
+                             f"{max_runs:,} runs: raise --max-runs to run it")
+    free = shutil.disk_usage(out.parent if str(out.parent) else ".").free
+    if size.table_bytes + size.traces_bytes > free:
+        raise SweepSizeError(f"{spec.source}: the sweep has {size.describe()}, more than the "
+                             f"{_human(free)} free in {out.parent or '.'}")
+    return size
+
+
+# ---------------------------------------------------------------------------------------
+# the check pass
+# ---------------------------------------------------------------------------------------
+def _check_item(item):
+    return check_block(*item)
 
 
 @dataclass(frozen=True)
-class SweepSpec:
-    base: dict
-    vary: tuple[Vary, ...]
-    mode: str = "grid"
-    samples: int | None = None
-    seed: int | None = None
-    chunk_size: int | None = None
-    traces_interval_s: float = 0.1
-    name: str = "sweep"
-    source: str = "<dict>"
-    base_dir: Path = field(default=Path("."), compare=False)
-
-    # ---- points ----------------------------------------------------------------------
-    def points(self) -> list[dict[str, Any]]:
-        """The varied values of every point, in sweep order."""
-        names = [v.name for v in self.vary]
-        if self.mode == "grid":
-            combos = itertools.product(*(v.values for v in self.vary))
-        elif self.mode == "list":
-            combos = zip(*(v.values for v in self.vary))
-        else:
-            u = _unit_samples(self.mode, self.samples, len(self.vary), self.seed)
-            cols = []
-            for j, v in enumerate(self.vary):
-                if v.log:
-                    x = np.exp(np.log(v.low) + u[:, j] * (np.log(v.high) - np.log(v.low)))
-                else:
-                    x = v.low + u[:, j] * (v.high - v.low)
-                cols.append([float(a) for a in x])
-            combos = zip(*cols)
-        return [dict(zip(names, c)) for c in combos]
-
-    def runs(self) -> list[Run]:
-        """Every run, validated (raises :class:`SweepSpecError` naming the point)."""
-        base_params = self._base_params()
-        runs, seen = [], {}
-        for i, values in enumerate(self.points()):
-            try:
-                spec = self._run_spec(base_params, values)
-            except (ParameterError, ProfileError, ValueError, TypeError) as exc:
-                shown = ", ".join(f"{k} = {v!r}" for k, v in values.items())
-                raise SweepSpecError(f"{self.source}: point {i} ({shown}): {exc}") from None
-            rid = run_id(spec)
-            if rid in seen:
-                raise SweepSpecError(
-                    f"{self.source}: points {seen[rid]} and {i} are the same run "
-                    f"({', '.join(f'{k} = {v!r}' for k, v in values.items())}); remove the duplicate value"
-                )
-            seen[rid] = i
-            runs.append(Run(i, rid, values, spec))
-        return runs
-
-    def _base_params(self):
-        b = self.base
-        if "scenario" in b:
-            return None
-        try:
-            p = resolve(_params_ref(b.get("params", "paper2010"), self.base_dir))
-            return p.replace(**b.get("set", {})) if b.get("set") else p
-        except ParameterError as exc:
-            raise SweepSpecError(f"{self.source}: [base] {exc}") from None
-
-    def _run_spec(self, base_params, values) -> RunSpec:
-        run_kw = {k: v for k, v in self.base.items() if k in RUN_KEYS}
-        param_changes = {}
-        for v in self.vary:
-            for f in v.fields:
-                if f in RUN_KEYS:
-                    run_kw[f] = values[v.name]
-                else:
-                    param_changes[f] = values[v.name]
-        if "scenario" in self.base:
-            spec = _scenario_spec(self.base["scenario"])
-            params = spec.params
-            if "params" in run_kw:
-                params = resolve(_params_ref(run_kw.pop("params"), self.base_dir))
-            if self.base.get("set"):
-                params = params.replace(**self.base["set"])
-            kw = {f.name: getattr(spec, f.name) for f in dataclasses.fields(spec)}
-            kw.update(run_kw)
-            kw["params"] = params.replace(**param_changes) if param_changes else params
-            return make_spec(**kw)
-        params = base_params
-        if "params" in run_kw:  # varied parameter set
-            params = resolve(_params_ref(run_kw.pop("params"), self.base_dir))
-            if self.base.get("set"):
-                params = params.replace(**self.base["set"])
-        if param_changes:
-            params = params.replace(**param_changes)
-        return make_spec(params=params, **run_kw)
-
-    def canonical(self) -> dict:
-        """A JSON-ready description of the sweep (stored in the table's metadata)."""
-        return {
-            "name": self.name, "mode": self.mode, "samples": self.samples, "seed": self.seed,
-            "base": {k: v for k, v in self.base.items()},
-            "vary": [{"name": v.name, "fields": list(v.fields),
-                      "values": list(v.values) if v.values is not None else None,
-                      "min": v.low, "max": v.high, "log": v.log} for v in self.vary],
-        }
+class Checked:
+    ids: np.ndarray
+    n_segments: int
+    max_output_interval_s: float
 
 
-def _params_ref(value, base_dir: Path):
-    """A parameter-set name, or a .toml path resolved relative to the spec's folder."""
-    if isinstance(value, ParameterSet):
-        return value
-    s = str(value)
-    if s.endswith(".toml") and not Path(s).is_absolute():
-        cand = base_dir / s
-        if cand.exists():
-            return str(cand)
-    return s
-
-
-def _scenario_spec(name: str) -> RunSpec:
-    try:
-        from .. import scenarios  # optional module (another part of the project)
-    except ImportError:
-        raise SweepSpecError(f"[base] scenario = {name!r}: this version of smafinger has no scenarios; "
-                             "give params/strategy/profile/voltage instead") from None
-    got = scenarios.get(name)
-    if isinstance(got, RunSpec):
-        return got
-    if isinstance(got, dict):
-        return make_spec(**got)
-    spec = getattr(got, "spec", None)
-    if isinstance(spec, RunSpec):
-        return spec
-    if callable(spec):
-        return spec()
-    raise SweepSpecError(f"[base] scenario = {name!r}: cannot turn {type(got).__name__} into a run spec")
-
-
-def _unit_samples(mode: str, n: int, d: int, seed: int | None) -> np.ndarray:
-    if mode == "random":
-        return np.random.default_rng(seed).random((n, d))
-    from scipy.stats import qmc
-
-    try:
-        sampler = qmc.LatinHypercube(d=d, rng=seed)
-    except TypeError:  # scipy < 1.15
-        sampler = qmc.LatinHypercube(d=d, seed=seed)
-    return sampler.random(n)
-
-
-def _err(source: str, where: str, msg: str) -> SweepSpecError:
-    return SweepSpecError(f"{source}: {where}: {msg}")
-
-
-def _number(source, where, value, integer=False):
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise _err(source, where, f"{value!r} is not a number")
-    if integer:
-        if isinstance(value, float) and not value.is_integer():
-            raise _err(source, where, f"{value!r} is not a whole number")
-        return int(value)
-    if not math.isfinite(value):
-        raise _err(source, where, f"{value!r} is not finite")
-    return float(value)
-
-
-def _coerce(source: str, where: str, target: str, value):
-    """A varied or base value converted to the kind its target field expects."""
-    if target in RUN_KEYS:
-        kind = RUN_KEYS[target]
-        if kind is float:
-            return _number(source, where, value)
-        if kind is bool:
-            if not isinstance(value, bool):
-                raise _err(source, where, f"{value!r} is not true/false")
-            return value
-        if not isinstance(value, str):
-            raise _err(source, where, f"{value!r} is not a string")
-        return value
-    try:
-        f = field_spec(target)
-    except ParameterError:
-        raise _err(source, where, f"{target!r} is neither a parameter nor a run setting "
-                                  f"({', '.join(sorted(RUN_KEYS))})") from None
-    kind = f.metadata["kind"]
-    if kind == "float":
-        return _number(source, where, value)
-    if kind == "bool":
-        if not isinstance(value, bool):
-            raise _err(source, where, f"{value!r} is not true/false")
-        return value
-    if kind == "str" or kind == "choice":
-        if not isinstance(value, str):
-            raise _err(source, where, f"{value!r} is not a string")
-        return value
-    return value  # pragma: no cover
-
-
-def load_spec(path: str | Path) -> SweepSpec:
-    """Read and validate a sweep spec file."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise SweepSpecError(f"sweep spec not found: {path}") from None
-    except IsADirectoryError:
-        raise SweepSpecError(f"sweep spec {path} is a directory, not a TOML file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SweepSpecError(f"{path}: not valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise SweepSpecError(f"{path}: not a text (TOML) file") from None
-    return parse_spec(data, source=str(path), base_dir=path.parent)
-
-
-def parse_spec(data: dict, source: str = "<dict>", base_dir: Path = Path(".")) -> SweepSpec:
-    """Validate a sweep spec given as a dict (the parsed TOML)."""
-    unknown = set(data) - {"base", "sweep", "vary"}
-    if unknown:
-        raise _err(source, "top level", f"unknown table(s) {', '.join(sorted(unknown))} (expected [base], [sweep], [vary])")
-    base = data.get("base", {})
-    sweep = data.get("sweep", {})
-    vary = data.get("vary")
-    for tname, table, allowed in (("[base]", base, BASE_KEYS), ("[sweep]", sweep, SWEEP_KEYS)):
-        if not isinstance(table, dict):
-            raise _err(source, tname, "must be a table")
-        bad = set(table) - allowed
-        if bad:
-            raise _err(source, tname, f"unknown key(s) {', '.join(sorted(bad))} (allowed: {', '.join(sorted(allowed))})")
-
-    # ---- [base] ---------------------------------------------------------------------
-    b: dict[str, Any] = {}
-    for k, v in base.items():
-        if k == "set":
-            if not isinstance(v, dict):
-                raise _err(source, "[base] set", f"{v!r} must be a table of parameter = value")
-            b["set"] = {f: _coerce(source, f"[base] set.{f}", f, x) for f, x in v.items()}
-            for f in b["set"]:
-                if f in RUN_KEYS:
-                    raise _err(source, f"[base] set.{f}", "is a run setting: put it in [base] directly")
-        elif k == "scenario":
-            if not isinstance(v, str):
-                raise _err(source, "[base] scenario", f"{v!r} is not a string")
-            try:
-                _scenario_spec(v)
-            except SweepSpecError as exc:
-                raise SweepSpecError(f"{source}: {exc}") from None
-            except (ValueError, KeyError) as exc:
-                raise _err(source, "[base] scenario", f"{str(exc).strip(chr(39))}") from None
-            b[k] = v
-        else:
-            b[k] = _coerce(source, f"[base] {k}", k, v)
-
-    # ---- [sweep] --------------------------------------------------------------------
-    mode = sweep.get("mode", "grid")
-    if mode not in MODES:
-        raise _err(source, "[sweep] mode", f"{mode!r} is not one of {', '.join(MODES)}")
-    samples = sweep.get("samples")
-    seed = sweep.get("seed")
-    if mode in ("random", "lhs"):
-        if samples is None:
-            raise _err(source, "[sweep] samples", f"is required with mode = {mode!r}")
-        samples = _number(source, "[sweep] samples", samples, integer=True)
-        if samples < 1:
-            raise _err(source, "[sweep] samples", f"{samples} must be >= 1")
-        seed = 0 if seed is None else _number(source, "[sweep] seed", seed, integer=True)
-        if seed < 0:
-            raise _err(source, "[sweep] seed", f"{seed} must be >= 0")
-    else:
-        for k in ("samples", "seed"):
-            if k in sweep:
-                raise _err(source, f"[sweep] {k}", f"is only used with mode = 'random' or 'lhs', not {mode!r}")
-    chunk = sweep.get("chunk_size")
-    if chunk is not None:
-        chunk = _number(source, "[sweep] chunk_size", chunk, integer=True)
-        if chunk < 1:
-            raise _err(source, "[sweep] chunk_size", f"{chunk} must be >= 1")
-    tr = _number(source, "[sweep] traces_interval_s", sweep.get("traces_interval_s", 0.1))
-    if tr <= 0:
-        raise _err(source, "[sweep] traces_interval_s", f"{tr} must be > 0")
-    name = sweep.get("name", Path(source).stem if source != "<dict>" else "sweep")
-    if not isinstance(name, str):
-        raise _err(source, "[sweep] name", f"{name!r} is not a string")
-
-    # ---- [vary] ---------------------------------------------------------------------
-    if not isinstance(vary, dict) or not vary:
-        raise _err(source, "[vary]", "is missing or empty: name at least one varied parameter")
-    varies = []
-    used_fields: dict[str, str] = {}
-    for vname, entry in vary.items():
-        where = f"[vary] {vname}"
-        if isinstance(entry, list):
-            entry = {"values": entry}
-        if not isinstance(entry, dict):
-            raise _err(source, where, f"{entry!r} must be a list of values or a table")
-        bad = set(entry) - VARY_KEYS
-        if bad:
-            raise _err(source, where, f"unknown key(s) {', '.join(sorted(bad))} (allowed: {', '.join(sorted(VARY_KEYS))})")
-        fields = entry.get("fields", [vname])
-        if isinstance(fields, str):
-            fields = [fields]
-        if not isinstance(fields, list) or not fields or not all(isinstance(f, str) for f in fields):
-            raise _err(source, f"{where}.fields", f"{fields!r} must be a non-empty list of field names")
-        for f in fields:
-            _coerce(source, f"{where}.fields", f, _probe_value(f))  # known field?
-            if f in used_fields:
-                raise _err(source, f"{where}.fields", f"{f!r} is already set by [vary] {used_fields[f]}")
-            if f in b.get("set", {}) or f in b:
-                raise _err(source, f"{where}.fields", f"{f!r} is also fixed in [base]; vary it or fix it, not both")
-            used_fields[f] = vname
-        log = entry.get("log", False)
-        if not isinstance(log, bool):
-            raise _err(source, f"{where}.log", f"{log!r} is not true/false")
-        has_values = "values" in entry
-        has_lin = any(k in entry for k in ("start", "stop", "num"))
-        has_range = any(k in entry for k in ("min", "max"))
-        if sum((has_values, has_lin, has_range)) != 1:
-            raise _err(source, where, "give exactly one of: values = [...], start/stop/num, or min/max")
-        if mode in ("random", "lhs"):
-            if not has_range:
-                raise _err(source, where, f"mode = {mode!r} samples within ranges: give min and max")
-            lo = _number(source, f"{where}.min", entry.get("min"))
-            hi = _number(source, f"{where}.max", entry.get("max"))
-            if not lo < hi:
-                raise _err(source, where, f"min = {lo!r} must be below max = {hi!r}")
-            if log and lo <= 0:
-                raise _err(source, f"{where}.min", f"{lo!r} must be > 0 with log = true")
-            for f in fields:
-                numeric = RUN_KEYS[f] is float if f in RUN_KEYS else field_spec(f).metadata["kind"] == "float"
-                if not numeric:
-                    raise _err(source, f"{where}.fields", f"{f!r} is not numeric and cannot be sampled in a range")
-            varies.append(Vary(vname, tuple(fields), None, lo, hi, log))
-            continue
-        if has_range:
-            raise _err(source, where, f"min/max ranges need mode = 'random' or 'lhs' (mode is {mode!r}); "
-                                      "use values or start/stop/num")
-        if has_lin:
-            for k in ("start", "stop", "num"):
-                if k not in entry:
-                    raise _err(source, where, f"start/stop/num: {k} is missing")
-            start = _number(source, f"{where}.start", entry["start"])
-            stop = _number(source, f"{where}.stop", entry["stop"])
-            num = _number(source, f"{where}.num", entry["num"], integer=True)
-            if num < 1:
-                raise _err(source, f"{where}.num", f"{num} must be >= 1")
-            if log:
-                if start <= 0 or stop <= 0:
-                    raise _err(source, where, f"log = true needs start and stop > 0 (got {start!r}, {stop!r})")
-                vals = np.geomspace(start, stop, num)
-            else:
-                vals = np.linspace(start, stop, num)
-            values = tuple(float(x) for x in vals)
-        else:
-            raw = entry["values"]
-            if not isinstance(raw, list) or not raw:
-                raise _err(source, f"{where}.values", f"{raw!r} must be a non-empty list")
-            if log:
-                raise _err(source, f"{where}.log", "only applies to start/stop/num or min/max")
-            values = tuple(_coerce(source, f"{where}.values[{i}]", fields[0], x) for i, x in enumerate(raw))
-            for f in fields[1:]:
-                for i, x in enumerate(raw):
-                    _coerce(source, f"{where}.values[{i}]", f, x)
-        varies.append(Vary(vname, tuple(fields), values))
-    if mode == "list":
-        lengths = {v.name: len(v.values) for v in varies}
-        if len(set(lengths.values())) > 1:
-            raise _err(source, "[vary]", f"mode = 'list' pairs the i-th values of every name; the lengths differ: {lengths}")
-    spec = SweepSpec(base=b, vary=tuple(varies), mode=mode, samples=samples, seed=seed,
-                     chunk_size=chunk, traces_interval_s=tr, name=name, source=source,
-                     base_dir=base_dir)
-    return spec
-
-
-def _probe_value(f: str):
-    """A value of the right kind for field ``f`` (to check only that the field exists)."""
-    if f in RUN_KEYS:
-        return {float: 1.0, bool: True, str: "x"}[RUN_KEYS[f]]
-    try:
-        kind = field_spec(f).metadata["kind"]
-    except ParameterError:
-        return None  # _coerce reports the unknown name
-    return {"float": 1.0, "bool": True}.get(kind, "x")
+def check_points(spec: SweepSpec, template, points, pool) -> Checked:
+    """Every point's run id, validated in ``pool``'s workers; refuses a bad or repeated point."""
+    n = points.n
+    ids = np.zeros(n, dtype="S16")
+    block = max(16, min(CHECK_BLOCK, math.ceil(n / (4 * pool.slots))))
+    items = ((template, a, cols) for a, cols in points.blocks(block))
+    n_seg, out_s = 0, 0.0
+    for res in pool.map_tasks(_check_item, items):
+        if res.error is not None:
+            point, values, msg = res.error
+            raise spec.point_error(point, values, msg)
+        ids[res.start:res.start + len(res.ids)] = res.ids
+        n_seg, out_s = max(n_seg, res.n_segments), max(out_s, res.max_output_interval_s)
+    order = np.argsort(ids, kind="stable")
+    same = np.flatnonzero(ids[order][1:] == ids[order][:-1])
+    if same.size:
+        second = order[1:][same]
+        j = int(second.min())
+        first = int(order[same[np.argmin(second)]])
+        vals = points.block(j, j + 1)
+        raise spec.duplicate_error(first, j, {k: v[0] for k, v in vals.items()})
+    return Checked(ids, n_seg, out_s)
 
 
 # ---------------------------------------------------------------------------------------
-# run identity
+# the run pass
 # ---------------------------------------------------------------------------------------
-def canonical_run(spec: RunSpec) -> dict:
-    """Everything that decides a run's outcome, as plain JSON-ready values."""
-    v = spec.voltage
-    return {
-        "schema": RUN_ID_SCHEMA,
-        "params": spec.params.to_dict(),
-        "strategy": spec.strategy,
-        "profile": spec.profile.to_text(),
-        "voltage": None if v is None else ",".join(f"{t!r}:{a!r}:{b!r}" for t, a, b in v.steps),
-        "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method,
-        "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg,
-        "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
-    }
+def _run_item(item, traces_interval_s, row):
+    template, pts, ids, cols = item
+    return run_block(template, pts, ids, cols, traces_interval_s, row)
 
 
-def run_id(spec: RunSpec) -> str:
-    """16 hex digits of the SHA-256 of the run's canonical spec."""
-    text = json.dumps(canonical_run(spec), sort_keys=True, separators=(",", ":"))
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+def _run_items(template, points, ids: np.ndarray, todo: np.ndarray, size: int):
+    """Chunks of ``size`` points still to run, in point order, made lazily."""
+    buf_p: list[int] = []
+    buf_c: dict[str, list] = {name: [] for name in points.names}
+
+    def take():
+        k = min(size, len(buf_p))
+        item = (template, buf_p[:k], [i.decode() for i in ids[buf_p[:k]].tolist()],
+                {name: col[:k] for name, col in buf_c.items()})
+        del buf_p[:k]
+        for col in buf_c.values():
+            del col[:k]
+        return item
+
+    for a, cols in points.blocks(CHECK_BLOCK):
+        sel = np.flatnonzero(todo[a:a + CHECK_BLOCK]).tolist()
+        buf_p.extend(a + k for k in sel)
+        for name, col in cols.items():
+            buf_c[name].extend(col[k] for k in sel)
+        while len(buf_p) >= size:
+            yield take()
+    while buf_p:
+        yield take()
 
 
-# ---------------------------------------------------------------------------------------
-# worker side: one run's row
-# ---------------------------------------------------------------------------------------
-def metrics_row(result, traces_interval_s: float | None = None) -> dict:
-    """The table row (metrics) of one run; with ``traces_interval_s`` also its sampled trace
-    under the key ``"_trace"``. Runs in the worker (picklable, module level)."""
-    s = result.summary()
-    th = result.signal("theta_deg")
-    t = result.t
-    moved = np.flatnonzero(np.abs(th - th[0]) > MOTION_THRESHOLD_DEG)
-    row = {
-        "status": "ok", "error": "",
-        "energy_upper_J": s["energy_J"]["upper"], "energy_lower_J": s["energy_J"]["lower"],
-        "peak_T_upper_C": s["peak_temperature_C"]["upper"],
-        "peak_T_lower_C": s["peak_temperature_C"]["lower"],
-        "peak_stress_upper_Pa": s["peak_stress_Pa"]["upper"],
-        "peak_stress_lower_Pa": s["peak_stress_Pa"]["lower"],
-        "interlock_violations": int(s["interlock_violations"]),
-        "theta_max_deg": float(np.max(th)), "theta_min_deg": float(np.min(th)),
-        "theta_final_deg": float(th[-1]),
-        "motion_start_s": float(t[moved[0]]) if moved.size else math.nan,
-        "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
-    }
-    segs = {seg["index"]: seg for seg in s["segments"]}
-    for i, seg_def in enumerate(result.spec.profile.segments):
-        seg = segs.get(i)
-        row[f"seg{i}_target_deg"] = float(seg_def.target_deg)
-        row[f"seg{i}_start_s"] = float(seg["start_s"]) if seg else math.nan
-        reached = seg["reached_s"] if seg else None
-        row[f"seg{i}_reached_s"] = math.nan if reached is None else float(reached)
-        row[f"seg{i}_overshoot_deg"] = float(seg["overshoot_deg"]) if seg else math.nan
-    if traces_interval_s:
-        step = max(1, round(traces_interval_s / result.spec.output_interval_s))
-        row["_trace"] = {c: np.ascontiguousarray(result.signal(c)[::step]) for c in TRACE_COLUMNS}
-    return row
-
-
-def error_row(exc: BaseException) -> dict:
-    return {"status": "error", "error": f"{type(exc).__name__}: {exc}"}
-
-
-def _column_order(varied: list[str], n_segments: int) -> list[str]:
-    cols = ["run_id", "point", *varied, *METRIC_COLUMNS]
-    for i in range(n_segments):
-        cols += [f"seg{i}_{c}" for c in SEGMENT_COLUMNS]
-    return cols
-
-
-# ---------------------------------------------------------------------------------------
-# storage
-# ---------------------------------------------------------------------------------------
-def parts_dir(out: Path) -> Path:
-    return out.with_name(out.name + ".parts")
-
-
-def traces_path(out: Path) -> Path:
-    """``results.parquet`` -> ``results.traces.parquet``."""
-    return out.with_name(out.stem + ".traces" + out.suffix)
-
-
-def _atomic_parquet(table, path: Path) -> None:
-    import pyarrow.parquet as pq
-
-    from ..results import atomic_write
-
-    atomic_write(path, lambda tmp: pq.write_table(table, tmp))
-
-
-def _rows_table(rows: list[dict]):
-    import pandas as pd
-    import pyarrow as pa
-
-    df = pd.DataFrame(rows)
-    return pa.Table.from_pandas(df, preserve_index=False)
-
-
-def _traces_table(traces: list[tuple[str, dict]]):
-    import pyarrow as pa
-
-    ids = [rid for rid, tr in traces for _ in range(len(tr["t_s"]))]
-    cols = {"run_id": pa.array(ids, type=pa.string())}
-    for c in TRACE_COLUMNS:
-        cols[c] = pa.array(np.concatenate([tr[c] for _, tr in traces]))
-    return pa.table(cols)
-
-
-def _write_part(pdir: Path, rows: list[dict], traces: list[tuple[str, dict]]) -> None:
-    """One part: ``part-<time>-<uid>.parquet`` (+ ``.traces.parquet``), each atomic.
-
-    The rows file is the 'done' mark: it is written last.
-    """
-    pdir.mkdir(exist_ok=True)
-    stem = f"part-{time.time_ns():020d}-{uuid.uuid4().hex[:8]}"
-    if traces:
-        _atomic_parquet(_traces_table(traces), pdir / f"{stem}.traces.parquet")
-    _atomic_parquet(_rows_table(rows), pdir / f"{stem}.parquet")
-
-
-def _read_meta(path: Path) -> dict | None:
-    import pyarrow.parquet as pq
-
-    meta = pq.read_schema(path).metadata or {}
-    if _META_KEY not in meta:
-        return None
-    return json.loads(meta[_META_KEY])
-
-
-def _load_done(out: Path, pdir: Path, traces: bool):
-    """Finished rows (metrics only, keyed by run_id) and traces from OUT and its parts.
-
-    Later sources win (parts, newest last): a run done twice keeps its newest row.
-    """
-    import pandas as pd
-    import pyarrow.parquet as pq
-
-    frames, tframes = [], []
-    if out.exists():
-        try:
-            meta = _read_meta(out)
-        except Exception:  # noqa: BLE001 - not parquet at all
-            meta = None
-        if meta is None:
-            raise SweepSpecError(f"{out} exists and is not a smafinger sweep table; choose another --out or remove it")
-        df = pq.read_table(out).to_pandas()
-        df = df.drop(columns=[c for c in ["point", *meta.get("varied", [])] if c in df.columns])
-        df["_src"] = "out"
-        frames.append(df)
-        tp = traces_path(out)
-        if traces and tp.exists():
-            tdf = pq.read_table(tp).to_pandas()
-            tdf["_src"] = "out"
-            tframes.append(tdf)
-    if pdir.is_dir():
-        for f in sorted(pdir.glob("part-*.parquet")):
-            if f.name.endswith(".traces.parquet"):
-                continue
-            try:
-                df = pq.read_table(f).to_pandas()
-            except Exception:  # noqa: BLE001 - an unreadable part is simply redone
-                continue
-            df["_src"] = f.name
-            frames.append(df)
-            tf = f.with_name(f.name[: -len(".parquet")] + ".traces.parquet")
-            if traces and tf.exists():
-                try:
-                    tdf = pq.read_table(tf).to_pandas()
-                except Exception:  # noqa: BLE001
-                    tdf = None
-                if tdf is not None:
-                    tdf["_src"] = f.name
-                    tframes.append(tdf)
-    rows = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=["run_id", "_src"])
-    trs = pd.concat(tframes, ignore_index=True) if tframes else pd.DataFrame(columns=["run_id", "_src"])
-    if traces and len(rows):
-        # a run counts as done only if its trace is there too (a failed run has none)
-        have = set(zip(trs["run_id"], trs["_src"]))
-        failed = (rows["status"] == "error").to_numpy() if "status" in rows.columns else np.zeros(len(rows), bool)
-        traced = np.array([(r, s) in have for r, s in zip(rows["run_id"], rows["_src"])], dtype=bool)
-        rows = rows[traced | failed]
-    rows = rows.drop_duplicates("run_id", keep="last")
-    return rows, trs
-
-
-# ---------------------------------------------------------------------------------------
-# running
-# ---------------------------------------------------------------------------------------
 @dataclass
 class SweepReport:
     out: Path
@@ -692,23 +210,60 @@ class SweepReport:
     failed: int
     wall_s: float
     backend: str
+    #: failed runs in the whole table (this invocation's and resumed ones)
+    failed_total: int = 0
+    #: the client's own time in the run pass, per run that ran (s)
+    client_s_per_run: float = math.nan
+
+
+class _Saver:
+    """Buffers finished rows and writes them as a part at least every ``interval_s``."""
+
+    def __init__(self, pdir: Path, interval_s: float, traces: bool):
+        self.pdir, self.interval_s, self.traces = pdir, interval_s, traces
+        self.rows: list[dict] = []
+        self.trs: list[dict] = []
+        self.last = time.monotonic()
+
+    def add(self, block) -> None:
+        self.rows.extend(block.rows)
+        if block.traces is not None:
+            self.trs.append(block.traces)
+        if time.monotonic() - self.last >= self.interval_s or len(self.rows) >= PART_MAX_ROWS:
+            self.flush()
+
+    def flush(self) -> None:
+        if self.rows:
+            tr = None
+            if self.traces:
+                tr = {c: np.concatenate([t[c] for t in self.trs]) for c in self.trs[0]} if self.trs else None
+            write_part(self.pdir, self.rows, tr if tr is not None else (_empty_traces() if self.traces else None))
+        self.rows, self.trs, self.last = [], [], time.monotonic()
+
+
+def _empty_traces() -> dict:
+    cols = {"run_id": np.zeros(0, dtype=object), "point": np.zeros(0, dtype=np.int64)}
+    cols.update({c: np.zeros(0, np.float64 if c == "t_s" else np.float32) for c in TRACE_COLUMNS})
+    return cols
 
 
 def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, workers: int | None = None,
               scheduler=None, traces: bool = False, progress: bool = False, console=None,
-              chunk_size: int | None = None,
-              on_progress: Callable[[int, int], None] | None = None) -> SweepReport:
+              chunk_size: int | None = None, on_progress: Callable[[int, int], None] | None = None,
+              max_runs: int = DEFAULT_MAX_RUNS, connect_timeout_s: float = batch.CONNECT_TIMEOUT_S,
+              progress_interval_s: float = 10.0) -> SweepReport:
     """Run a sweep (resuming one that was interrupted) and write its table to ``out``.
 
-    ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``) or ``Client``; without it
-    the runs go to ``workers`` local processes (default: every core). ``on_progress(done,
-    total)`` is called after each finished chunk. Returns a :class:`SweepReport`.
+    ``scheduler``: a Dask scheduler address (``tcp://HOST:PORT``, a cluster you trust: its
+    workers run pickled code) or ``Client``; without it the runs go to ``workers`` local
+    processes (default: every core). ``progress``: a live bar on ``console``; otherwise, with
+    a ``console``, a plain progress line every ``progress_interval_s``. ``on_progress(done,
+    total)`` is called after each finished chunk. Sweeps above ``max_runs`` runs are refused
+    before anything is made. Returns a :class:`SweepReport`.
     """
-    from ..engine import batch
-
     t_start = time.perf_counter()
     if not isinstance(spec, SweepSpec):
-        spec = load_spec(spec)
+        spec = load_spec(spec, max_runs=max_runs)
     out = Path(out) if out is not None else Path(f"{spec.name}.parquet")
     if out.suffix.lower() not in (".parquet", ".pq"):
         raise SweepSpecError(f"--out {out}: the results file must end in .parquet")
@@ -716,110 +271,96 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
         raise SweepSpecError(f"--out {out}: folder {out.parent} does not exist")
     if workers is not None and workers < 1:
         raise SweepSpecError(f"--workers {workers}: must be >= 1")
-    runs = spec.runs()
-    by_id = {r.run_id: r for r in runs}
+    check_size(spec, out, traces, max_runs)
+    template = spec.template()
+    points = spec.point_source()
+    total = points.n
     pdir = parts_dir(out)
-    done_rows, _ = _load_done(out, pdir, traces)
-    done_ids = set(done_rows["run_id"]) & set(by_id)
-    todo = [r for r in runs if r.run_id not in done_ids]
-    total = len(runs)
-    if traces and any(r.spec.output_interval_s > spec.traces_interval_s * (1 + 1e-9) for r in todo):
-        raise SweepSpecError(f"{spec.source}: [sweep] traces_interval_s = {spec.traces_interval_s} is shorter "
-                             "than the runs' output_interval_s")
-    reduce = partial(metrics_row, traces_interval_s=spec.traces_interval_s if traces else None)
-    _say(console, f"sweep {spec.name}: {total} runs"
-                  + (f", {len(done_ids)} already done" if done_ids else ""))
-    backend = "nothing left to run"
-    failed = 0
-    if todo:
-        pool = batch.make_pool(workers, scheduler)
-        backend = (f"Dask scheduler {scheduler if isinstance(scheduler, str) else 'client'} "
-                   f"({pool.slots} worker threads)" if scheduler is not None else
-                   f"{pool.slots} local worker process{'es' if pool.slots > 1 else ''}"
-                   if pool.slots > 1 else "this process")
-        _say(console, f"running {len(todo)} runs on {backend}")
-        size = chunk_size or spec.chunk_size or batch.auto_chunk_size(len(todo), pool.slots)
-        chunks = batch.chunked([(r.run_id, r.spec) for r in todo], size)
-        done = len(done_ids)
-        bar = _progress(console) if progress else None
-        task = bar.add_task("sweep", total=total, completed=done) if bar else None
+    pool = None
+    say = Progress(console, progress, progress_interval_s, spec.name)
+    try:
+        if scheduler is not None or total > CHECK_HERE_MAX:
+            pool = batch.make_pool(workers, scheduler, connect_timeout_s)
+            say.pool(pool)
+        checked = check_points(spec, template, points, pool or batch.SerialPool())
+        if traces and checked.max_output_interval_s > spec.traces_interval_s * (1 + 1e-9):
+            raise SweepSpecError(f"{spec.source}: [sweep] traces_interval_s = {spec.traces_interval_s} is shorter "
+                                 "than the runs' output_interval_s")
+        clean_stale(out)
+        index = IdIndex(checked.ids)
         try:
-            if bar:
-                bar.start()
-            for outcomes in pool.map_chunks(chunks, reduce):
-                rows, trs = [], []
-                for rid, ok, value in outcomes:
-                    if ok:
-                        tr = value.pop("_trace", None)
-                        if tr is not None:
-                            trs.append((rid, tr))
-                    else:
-                        value = error_row(value)
-                        failed += 1
-                    rows.append({"run_id": rid, **value})
-                _write_part(pdir, rows, trs)
-                done += len(rows)
-                if bar:
-                    bar.update(task, completed=done)
-                if on_progress:
-                    on_progress(done, total)
-        except KeyboardInterrupt:
-            if bar:
-                bar.stop()
+            finished = Finished(out, pdir, index, traces)
+        except StoreError as exc:
+            raise SweepSpecError(str(exc)) from None
+        done0 = int(finished.done.sum())
+        say.line(f"sweep {spec.name}: {total} runs" + (f", {done0} already done" if done0 else ""))
+        todo = ~finished.done
+        ran, failed, backend, client_s = total - done0, 0, "nothing left to run", math.nan
+        if ran:
+            if pool is None:
+                pool = batch.make_pool(workers, scheduler, connect_timeout_s)
+                say.pool(pool)
+            backend = pool.describe()
+            say.line(f"running {ran} runs on {backend}")
+            size = chunk_size or spec.chunk_size or batch.auto_chunk_size(ran, pool.slots)
+            fn = partial(_run_item, traces_interval_s=spec.traces_interval_s if traces else None, row=metrics_row)
+            failed, client_s = _run_pass(spec, pool, fn, _run_items(template, points, checked.ids, todo, size),
+                                         _Saver(pdir, spec.save_interval_s, traces), say, done0, total, on_progress)
+    finally:
+        if pool is not None:
             pool.close(cancel=True)
-            raise SweepInterrupted(done, total, pdir) from None
-        except BaseException:
-            if bar:
-                bar.stop()
-            pool.close(cancel=True)
-            raise
-        if bar:
-            bar.stop()
-        pool.close()
-    _consolidate(spec, runs, out, pdir, traces)
+    finished = Finished(out, pdir, index, traces)
+    if not finished.done.all():
+        raise RuntimeError(f"internal error: {int((~finished.done).sum())} runs have no result after the sweep")
+    failed_total = finished.failed_count()
+    _merge(spec, out, pdir, finished, points, checked, traces)
     return SweepReport(out=out, traces_out=traces_path(out) if traces else None, total=total,
-                       resumed=len(done_ids), ran=len(todo), failed=failed,
-                       wall_s=time.perf_counter() - t_start, backend=backend)
+                       resumed=done0, ran=ran, failed=failed, wall_s=time.perf_counter() - t_start,
+                       backend=backend, failed_total=failed_total, client_s_per_run=client_s)
 
 
-def _consolidate(spec: SweepSpec, runs: list[Run], out: Path, pdir: Path, traces: bool) -> None:
-    """Join the point table with every finished row; write OUT (and traces) atomically."""
-    import pandas as pd
-    import pyarrow as pa
+def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tuple[int, float]:
+    """Run the chunks, saving rows as they come; returns (failed runs, client s per run)."""
+    failed, ran, busy = 0, 0, 0.0
+    say.start(total, done)
+    try:
+        for block in pool.map_tasks(fn, items):
+            t0 = time.perf_counter()
+            saver.add(block)
+            n = len(block.rows)
+            done, ran, failed = done + n, ran + n, failed + block.failed
+            say.update(done, failed, pool)
+            busy += time.perf_counter() - t0
+            if on_progress:
+                on_progress(done, total)
+        saver.flush()
+    except KeyboardInterrupt:
+        say.stop()
+        saver.flush()
+        raise SweepInterrupted(done, total, saver.pdir) from None
+    except BaseException:
+        say.stop()
+        saver.flush()
+        raise
+    say.stop()
+    return failed, busy / ran if ran else math.nan
 
-    rows, trs = _load_done(out, pdir, traces)
-    ids = [r.run_id for r in runs]
-    rows = rows[rows["run_id"].isin(set(ids))]
-    missing = set(ids) - set(rows["run_id"])
-    if missing:
-        raise RuntimeError(f"internal error: {len(missing)} runs have no result after the sweep")
-    varied = [v.name for v in spec.vary]
-    points = pd.DataFrame([{"run_id": r.run_id, "point": r.point, **r.values} for r in runs])
-    keep = rows.drop(columns=["_src"])
-    table = points.merge(keep, on="run_id", how="left", validate="one_to_one")
-    n_seg = max(len(r.spec.profile.segments) for r in runs)
-    cols = _column_order(varied, n_seg)
-    extra = [c for c in table.columns if c not in cols]
-    table = table[[c for c in cols if c in table.columns] + extra].sort_values("point").reset_index(drop=True)
-    table["point"] = table["point"].astype("int64")
-    for c in ("interlock_violations", "steps"):
-        if c in table.columns and not table[c].isna().any():
-            table[c] = table[c].astype("int64")
-    meta = {"varied": varied, "spec": spec.canonical(), "version": _version(),
-            "traces": traces, "motion_threshold_deg": MOTION_THRESHOLD_DEG}
-    if traces:
-        src = dict(zip(rows["run_id"], rows["_src"]))
-        trs = trs[[src.get(r) == s for r, s in zip(trs["run_id"], trs["_src"])]]
-        order = {rid: i for i, rid in enumerate(ids)}
-        trs = trs.assign(_o=trs["run_id"].map(order)).sort_values(["_o", "t_s"], kind="stable")
-        trs = trs.drop(columns=["_o", "_src"]).reset_index(drop=True)
-        ttab = pa.Table.from_pandas(trs, preserve_index=False)
-        ttab = ttab.replace_schema_metadata({**(ttab.schema.metadata or {}), _META_KEY: json.dumps(
-            {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s})})
-        _atomic_parquet(ttab, traces_path(out))
-    tab = pa.Table.from_pandas(table, preserve_index=False)
-    tab = tab.replace_schema_metadata({**(tab.schema.metadata or {}), _META_KEY: json.dumps(meta, default=str)})
-    _atomic_parquet(tab, out)
+
+def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Checked, traces: bool) -> None:
+    """Write ``OUT`` (and its traces) from the finished rows, then remove the parts."""
+    canonical = json.loads(json.dumps(spec.canonical(), default=str))
+    meta = finished.out_meta or {}
+    unchanged = (finished.n_parts == 0 and meta.get("spec") == canonical
+                 and (not traces or meta.get("traces")))
+    if not unchanged:
+        varied = [v.name for v in spec.vary]
+        if traces:
+            samples = max(1, round(_max_t_end(spec) / spec.traces_interval_s) + 1)
+            write_traces(traces_path(out), finished, samples,
+                         {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s})
+        write_table(out, finished, points, varied, checked.n_segments,
+                    {"varied": varied, "spec": canonical, "version": _version(), "traces": traces,
+                     "motion_threshold_deg": MOTION_THRESHOLD_DEG})
     if pdir.is_dir():
         for f in pdir.iterdir():
             try:
@@ -830,6 +371,14 @@ def _consolidate(spec: SweepSpec, runs: list[Run], out: Path, pdir: Path, traces
             pdir.rmdir()
         except OSError:
             pass
+
+
+def _max_t_end(spec: SweepSpec) -> float:
+    t_end = spec.base.get("t_end_s", 20.0)
+    for v in spec.vary:
+        if "t_end_s" in v.fields:
+            t_end = max(v.values) if v.values is not None else v.high
+    return float(t_end)
 
 
 def read_results(path: str | Path, with_timing: bool = True):
@@ -848,19 +397,7 @@ def _version() -> str:
     return smafinger.__version__
 
 
-def _say(console, text: str) -> None:
-    if console is not None:
-        console.print(text, highlight=False)
-
-
-def _progress(console):
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
-                               TimeRemainingColumn)
-
-    return Progress(TextColumn("sweep"), BarColumn(), MofNCompleteColumn(), TextColumn("runs"),
-                    TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(), console=console)
-
-
-__all__ = ["SweepSpec", "SweepSpecError", "SweepInterrupted", "SweepReport", "Vary", "Run",
-           "load_spec", "parse_spec", "run_sweep", "run_id", "canonical_run", "metrics_row",
-           "read_results", "parts_dir", "traces_path", "METRIC_COLUMNS", "TRACE_COLUMNS"]
+__all__ = ["SweepSpec", "SweepSpecError", "SweepSizeError", "SweepInterrupted", "SweepReport", "SweepSize",
+           "Vary", "Run", "load_spec", "parse_spec", "run_sweep", "run_id", "canonical_run", "metrics_row",
+           "read_results", "parts_dir", "traces_path", "sweep_size", "check_size", "METRIC_COLUMNS",
+           "TRACE_COLUMNS", "DEFAULT_MAX_RUNS"]

@@ -1,21 +1,19 @@
 """Batch engine: many runs in one call, in parallel, each bit-identical to the run made alone.
 
 Every run is an ordinary :func:`~smafinger.engine.run.run_spec` call; the batch engine only
-decides *where* it happens:
+decides *where* it happens (:mod:`.pools`: this process, local worker processes, or a Dask
+cluster) and keeps the client lean:
 
-- ``workers=1``: one after the other in this process;
-- ``workers=N`` (default: every core this process may use): ``N`` worker processes
-  (:class:`concurrent.futures.ProcessPoolExecutor`, started with ``forkserver`` where
-  available, else ``spawn``), each warmed up once (numba's compiled kernel loaded from its
-  on-disk cache) before its first task;
-- :class:`DaskPool`: the workers of an existing ``dask.distributed`` cluster (optional extra,
-  ``pip install smafinger[distributed]``; imported only when used), warmed up once per
-  worker by a worker plugin.
+- runs travel in *chunks* (several runs per task) so that each task carries enough work to
+  hide the scheduling cost;
+- :func:`iter_batch` draws its runs lazily and yields each outcome as it finishes, with
+  only a few chunks per worker in flight, so a batch of any size runs in bounded memory
+  (write each result away as it comes);
+- ``reduce`` runs in the worker, so only what it returns travels back: :class:`Compact`
+  keeps chosen signals, decimated, in float32 (:func:`compact_signals`).
 
-Runs travel in *chunks* (several runs per task) so that each task carries enough work to
-hide the scheduling cost. A run never depends on which worker, chunk or order it ran in:
-the kernel is deterministic and has no shared state, so its output is bit-identical to the
-same run made alone.
+A run never depends on which worker, chunk or order it ran in: the kernel is deterministic
+and has no shared state, so its output is bit-identical to the same run made alone.
 
 >>> from smafinger.engine.batch import run_batch, specs_product
 >>> specs = specs_product(["paper2010", "authors2020"], profiles=["0:-25", "0:-55"],
@@ -25,85 +23,28 @@ same run made alone.
 
 from __future__ import annotations
 
+import itertools
 import math
-import os
-import signal
-from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
-from .run import RunSpec, make_spec, run_spec
+import numpy as np
 
-#: a task: (key, spec); a chunk: a list of tasks; a task's outcome: (key, ok, value)
-Task = tuple[Any, RunSpec]
-Outcome = tuple[Any, bool, Any]
+from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itself is imported on use)
+from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
+                    SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, warm_up)
+from .run import RunSpec, make_spec
 
-_WARM = False
-
-
-class BatchError(RuntimeError):
-    """A batch could not be completed (a run failed with ``errors="raise"``, a pool broke)."""
-
-
-class DistributedMissing(ImportError):
-    """``dask.distributed`` is needed (``--scheduler``) but not installed."""
+#: signals kept in float64 by :func:`compact_signals`: time is the join key of every trace
+#: (float32 cannot hold 0.1 s steps exactly and resolves only 61 us at t = 1000 s). Every
+#: other signal is a physical quantity whose float32 rounding (6e-8 relative: 5e-6 deg at
+#: 90 deg, 2e-5 K at 300 degC, 30 Pa at 5e8 Pa) is far below the model's own accuracy.
+FLOAT64_SIGNALS = ("t_s",)
 
 
 # ---------------------------------------------------------------------------------------
-# worker side
+# items and chunks
 # ---------------------------------------------------------------------------------------
-def warm_up() -> bool:
-    """Load (or compile) the numba kernel in this process, once: a 2 ms run.
-
-    Returns True if this call did the work, False if the process was already warm.
-    """
-    global _WARM
-    if _WARM:
-        return False
-    run_spec(make_spec("paper2010", "cooperative", "0:-30", t_end_s=0.002))
-    _WARM = True
-    return True
-
-
-def is_warm() -> bool:
-    return _WARM
-
-
-def _init_local_worker() -> None:
-    # Ctrl-C goes to the whole process group: let only the parent handle it, so that it can
-    # save what is done and stop the pool cleanly.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    warm_up()
-
-
-def run_chunk(tasks: Sequence[Task], reduce: Callable | None = None) -> list[Outcome]:
-    """Run a chunk of tasks here; the worker-side function of every backend.
-
-    Each outcome is ``(key, True, value)`` with ``value = reduce(result)`` (the
-    :class:`~smafinger.results.SimulationResult` itself without ``reduce``), or
-    ``(key, False, exception)`` if the run (or ``reduce``) raised.
-    """
-    warm_up()
-    out: list[Outcome] = []
-    for key, spec in tasks:
-        try:
-            res = run_spec(spec)
-            out.append((key, True, reduce(res) if reduce is not None else res))
-        except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
-            out.append((key, False, exc))
-    return out
-
-
-# ---------------------------------------------------------------------------------------
-# helpers
-# ---------------------------------------------------------------------------------------
-def available_cores() -> int:
-    """Cores this process may run on (affinity-aware)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def as_spec(item: RunSpec | dict) -> RunSpec:
     """A :class:`RunSpec` from a spec or from :func:`make_spec` keyword arguments."""
     if isinstance(item, RunSpec):
@@ -134,9 +75,15 @@ def specs_product(params: Iterable = ("paper2010",), profiles: Iterable | None =
     return specs
 
 
-def chunked(tasks: Sequence[Task], size: int) -> list[list[Task]]:
+def chunked(tasks: Iterable, size: int) -> Iterator[list]:
+    """Consecutive lists of ``size`` items (the last may be shorter), drawn lazily."""
     size = max(1, int(size))
-    return [list(tasks[i:i + size]) for i in range(0, len(tasks), size)]
+    it = iter(tasks)
+    while True:
+        chunk = list(itertools.islice(it, size))
+        if not chunk:
+            return
+        yield chunk
 
 
 def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 16, lo: int = 1, hi: int = 64) -> int:
@@ -151,247 +98,149 @@ def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 16, lo: int = 1, h
     return max(lo, min(hi, math.ceil(n_tasks / (max(1, slots) * per_slot))))
 
 
-def _mp_context():
-    import multiprocessing as mp
-
-    methods = mp.get_all_start_methods()
-    if "forkserver" in methods:
-        ctx = mp.get_context("forkserver")
-        # import numpy, numba and the engine once in the server; workers fork from it
-        ctx.set_forkserver_preload(["smafinger.engine.batch"])
-        return ctx
-    return mp.get_context("spawn")  # pragma: no cover - Windows / macOS fallback
-
-
 # ---------------------------------------------------------------------------------------
-# pools
+# compact outputs
 # ---------------------------------------------------------------------------------------
-class SerialPool:
-    """Runs the chunks one after the other in this process."""
+def compact_signals(result, names: Sequence[str] | None = None, every: int = 1) -> dict[str, np.ndarray]:
+    """Signals of one result, every ``every``-th sample, float32 except :data:`FLOAT64_SIGNALS`.
 
-    slots = 1
-
-    def map_chunks(self, chunks: Iterable[list[Task]], reduce: Callable | None = None) -> Iterator[list[Outcome]]:
-        for c in chunks:
-            yield run_chunk(c, reduce)
-
-    def close(self, cancel: bool = False) -> None:
-        pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close(cancel=exc[0] is not None)
-
-
-class LocalPool(SerialPool):
-    """A pool of worker processes on this machine (kept alive until :meth:`close`)."""
-
-    def __init__(self, workers: int | None = None):
-        self.slots = available_cores() if workers is None else workers
-        if self.slots < 1:
-            raise ValueError(f"workers = {workers!r} must be >= 1")
-        # compile here first if numba's disk cache is stale: the workers then load it
-        # instead of compiling all at once
-        warm_up()
-        self._ex = ProcessPoolExecutor(max_workers=self.slots, mp_context=_mp_context(),
-                                       initializer=_init_local_worker)
-
-    def start(self) -> "LocalPool":
-        """Start and warm up every worker now (otherwise it happens with the first tasks)."""
-        list(self._ex.map(_noop, range(self.slots)))
-        return self
-
-    def map_chunks(self, chunks, reduce=None):
-        """Yield each chunk's outcomes as soon as it finishes (completion order)."""
-        from concurrent.futures.process import BrokenProcessPool
-
-        pending = {self._ex.submit(run_chunk, c, reduce) for c in chunks}
-        try:
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for f in done:
-                    try:
-                        yield f.result()
-                    except BrokenProcessPool as exc:
-                        raise BatchError(f"a worker process died ({exc}); finished runs are kept") from None
-        finally:
-            for f in pending:
-                f.cancel()
-
-    def close(self, cancel: bool = False) -> None:
-        self._ex.shutdown(wait=True, cancel_futures=cancel)
-
-
-def _noop(_):
-    return os.getpid()
-
-
-def _import_distributed():
-    try:
-        import distributed  # noqa: F401
-    except ImportError:
-        raise DistributedMissing(
-            "a Dask scheduler needs dask.distributed, which is not installed: "
-            "pip install 'smafinger[distributed]'"
-        ) from None
-    return distributed
-
-
-def __getattr__(name: str):
-    # The worker plugin subclasses distributed.WorkerPlugin, so it is created on first use
-    # (distributed stays an optional import); it is cached here so that pickles of it
-    # resolve to the same class on the workers.
-    if name == "WarmUpPlugin":
-        distributed = _import_distributed()
-
-        class WarmUpPlugin(distributed.WorkerPlugin):
-            """Loads the numba kernel once per worker, when the worker starts."""
-
-            name = "smafinger-warm-up"
-
-            def setup(self, worker):  # noqa: D401
-                warm_up()
-
-        WarmUpPlugin.__module__ = __name__
-        WarmUpPlugin.__qualname__ = "WarmUpPlugin"
-        globals()["WarmUpPlugin"] = WarmUpPlugin
-        return WarmUpPlugin
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def _worker_info() -> dict:
-    import smafinger
-
-    return {"version": smafinger.__version__, "warm": is_warm(), "pid": os.getpid()}
-
-
-class DaskPool(SerialPool):
-    """Runs chunks on a ``dask.distributed`` cluster.
-
-    ``address``: the scheduler (``tcp://HOST:PORT``) or an existing ``Client``. Every worker
-    must be able to import the same version of smafinger. A worker lost mid-run is replaced
-    by the cluster (its tasks are rescheduled on the others); results are only yielded once.
+    ``names``: exported signal names (default: every column of ``result.to_pandas()``).
     """
+    every = int(every)
+    if every < 1:
+        raise ValueError(f"every = {every!r} must be >= 1")
+    if names is None:
+        names = list(result.to_pandas().columns)
+    out = {}
+    for n in names:
+        x = np.asarray(result.signal(n))[::every]
+        out[n] = np.ascontiguousarray(x, dtype=np.float64 if n in FLOAT64_SIGNALS else np.float32)
+    return out
 
-    def __init__(self, address, timeout_s: float = 10.0):
-        distributed = _import_distributed()
-        self._distributed = distributed
-        if isinstance(address, distributed.Client):
-            self.client = address
-            self._own = False
-        else:
-            try:
-                self.client = distributed.Client(address, timeout=f"{timeout_s}s",
-                                                 set_as_default=False)
-            except (OSError, TimeoutError) as exc:
-                raise BatchError(f"cannot connect to the Dask scheduler at {address}: {exc}") from None
-            self._own = True
-        warm_up()  # refreshes numba's disk cache, which workers on this machine then load
+
+@dataclass(frozen=True)
+class CompactResult:
+    """What :class:`Compact` keeps of a run: its spec, its summary (metrics computed at full
+    resolution, before decimation) and some signals, decimated, mostly float32."""
+
+    spec: RunSpec
+    summary: dict
+    signals: dict
+    every: int
+
+    def signal(self, name: str) -> np.ndarray:
         try:
-            self.client.register_plugin(__getattr__("WarmUpPlugin")(), name="smafinger-warm-up")
-            info = self.client.run(_worker_info)
-        except Exception as exc:
-            self.close()
-            raise BatchError(f"the Dask workers cannot run smafinger ({type(exc).__name__}: {exc}); "
-                             "install smafinger on every worker") from None
-        import smafinger
-
-        bad = {w: i["version"] for w, i in info.items() if i["version"] != smafinger.__version__}
-        if bad:
-            self.close()
-            raise BatchError(f"the Dask workers run other smafinger versions than {smafinger.__version__}: {bad}")
+            return self.signals[name]
+        except KeyError:
+            raise KeyError(f"signal {name!r} was not kept (kept: {', '.join(self.signals)})") from None
 
     @property
-    def slots(self) -> int:
-        n = sum(self.client.nthreads().values())
-        return max(1, n)
+    def nbytes(self) -> int:
+        return sum(a.nbytes for a in self.signals.values())
 
-    def map_chunks(self, chunks, reduce=None):
-        futures = [self.client.submit(run_chunk, c, reduce, pure=False) for c in chunks]
-        ac = self._distributed.as_completed(futures, loop=self.client.loop)
-        try:
-            for f in ac:
-                try:
-                    res = f.result()
-                except Exception as exc:  # KilledWorker and the like
-                    raise BatchError(f"a Dask task failed ({type(exc).__name__}: {exc}); finished runs are kept") from None
-                f.release()
-                yield res
-        finally:
-            left = [f for f in futures if not f.done()]
-            if left:
-                self.client.cancel(left)
+    def to_pandas(self):
+        import pandas as pd
 
-    def close(self, cancel: bool = False) -> None:
-        if self._own:
-            self.client.close()
+        return pd.DataFrame(self.signals)
 
 
-def make_pool(workers: int | None = None, scheduler=None):
-    """:class:`DaskPool` with a scheduler, else :class:`SerialPool` for one worker, else
-    :class:`LocalPool`."""
-    if scheduler is not None:
-        return DaskPool(scheduler)
-    if workers is not None and workers < 1:
-        raise ValueError(f"workers = {workers!r} must be >= 1")
-    n = workers or available_cores()
-    return SerialPool() if n == 1 else LocalPool(n)
+@dataclass(frozen=True)
+class Compact:
+    """A ``reduce`` for :func:`run_batch`: keep ``signals`` (default: all) every ``every``-th
+    sample as float32 (time as float64), plus the run's summary.
+
+    A 20 s run at 1 ms output keeps 20,001 samples per signal: 80 kB per float32 signal
+    instead of the result's full float64 table.
+    """
+
+    signals: tuple[str, ...] | None = None
+    every: int = 1
+
+    def __post_init__(self):
+        if int(self.every) < 1:
+            raise ValueError(f"every = {self.every!r} must be >= 1")
+
+    def __call__(self, result) -> CompactResult:
+        return CompactResult(result.spec, result.summary(), compact_signals(result, self.signals, self.every),
+                             int(self.every))
 
 
 # ---------------------------------------------------------------------------------------
 # one-call API
 # ---------------------------------------------------------------------------------------
-def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, scheduler=None,
-              reduce: Callable | None = None, chunk_size: int | None = None,
-              errors: str = "raise", pool=None) -> list:
-    """Run many simulations in parallel; the results in input order.
+def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, reduce: Callable | None = None,
+               chunk_size: int | None = None, pool=None,
+               connect_timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator[tuple[int, bool, Any]]:
+    """Run many simulations; yield ``(index, ok, value)`` for each as it finishes.
 
-    Parameters
-    ----------
-    runs : iterable of RunSpec or dict
-        Validated specs (:func:`~smafinger.engine.run.make_spec`) or its keyword arguments.
-    workers : int, optional
-        Local worker processes (default: every available core; 1: in this process).
-    scheduler : str or distributed.Client, optional
-        Run on this Dask cluster instead.
-    reduce : callable, optional
-        Applied to each :class:`~smafinger.results.SimulationResult` in the worker, so that
-        only what it returns travels back (must be picklable: a module-level function or a
-        ``functools.partial`` of one). Default: the whole result.
-    chunk_size : int, optional
-        Runs per task (default: about four tasks per worker, at most 64 runs).
-    errors : {"raise", "return"}
-        A failed run raises :class:`BatchError` (after the others finished), or its
-        exception is returned in its place.
-    pool : optional
-        A pool from :func:`make_pool` to reuse (kept open), e.g. in a loop of batches.
+    ``runs`` is drawn lazily (a generator of specs is fine) and only a few chunks per worker
+    are in flight, so memory stays bounded whatever the batch size: store each value as it
+    comes. ``value`` is ``reduce(result)`` (the result itself without ``reduce``) when ``ok``,
+    else the exception. Items are :class:`RunSpec`, :func:`make_spec` keyword dicts
+    (validated here, as they are drawn) or recipes with a ``build()`` method (built in the
+    worker). Other arguments as in :func:`run_batch`.
     """
-    if errors not in ("raise", "return"):
-        raise ValueError(f"errors = {errors!r} is not one of raise, return")
-    specs = [as_spec(r) for r in runs]
-    if not specs:
-        return []
     own = pool is None
     if own:
-        pool = make_pool(workers, scheduler)
+        pool = make_pool(workers, scheduler, connect_timeout_s)
     try:
-        size = chunk_size or auto_chunk_size(len(specs), pool.slots)
-        tasks = list(enumerate(specs))
-        out: list[Any] = [None] * len(specs)
-        failed: list[tuple[int, Exception]] = []
-        for outcomes in pool.map_chunks(chunked(tasks, size), reduce):
-            for i, ok, value in outcomes:
-                out[i] = value
-                if not ok:
-                    failed.append((i, value))
+        if chunk_size is None:
+            n = len(runs) if hasattr(runs, "__len__") else 0
+            chunk_size = auto_chunk_size(n, pool.slots) if n else 8
+        items = ((i, r if not isinstance(r, dict) else as_spec(r)) for i, r in enumerate(runs))
+        for outcomes in pool.map_chunks(chunked(items, chunk_size), reduce):
+            yield from outcomes
     except BaseException:
         if own:
             pool.close(cancel=True)
         raise
     if own:
         pool.close()
+
+
+def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, scheduler=None,
+              reduce: Callable | None = None, chunk_size: int | None = None,
+              errors: str = "raise", pool=None, connect_timeout_s: float = CONNECT_TIMEOUT_S) -> list:
+    """Run many simulations in parallel; the results in input order.
+
+    Parameters
+    ----------
+    runs : iterable of RunSpec or dict
+        Validated specs (:func:`~smafinger.engine.run.make_spec`) or its keyword arguments
+        (all validated before anything runs).
+    workers : int, optional
+        Local worker processes (default: every available core; 1: in this process).
+    scheduler : str or distributed.Client, optional
+        Run on this Dask cluster instead (one you trust: its workers run pickled code).
+    reduce : callable, optional
+        Applied to each :class:`~smafinger.results.SimulationResult` in the worker, so that
+        only what it returns travels back (must be picklable: a module-level function, a
+        ``functools.partial`` of one, or :class:`Compact`). Default: the whole result.
+    chunk_size : int, optional
+        Runs per task (default: about 16 tasks per worker, at most 64 runs).
+    errors : {"raise", "return"}
+        A failed run raises :class:`BatchError` (after the others finished), or its
+        exception is returned in its place.
+    pool : optional
+        A pool from :func:`make_pool` to reuse (kept open), e.g. in a loop of batches.
+    connect_timeout_s : float
+        Time allowed to reach the Dask scheduler.
+
+    All results are held in the returned list: for large batches use :func:`iter_batch`
+    (bounded memory) or a ``reduce``.
+    """
+    if errors not in ("raise", "return"):
+        raise ValueError(f"errors = {errors!r} is not one of raise, return")
+    specs = [as_spec(r) for r in runs]
+    if not specs:
+        return []
+    out: list[Any] = [None] * len(specs)
+    failed: list[tuple[int, Exception]] = []
+    for i, ok, value in iter_batch(specs, workers=workers, scheduler=scheduler, reduce=reduce,
+                                   chunk_size=chunk_size, pool=pool, connect_timeout_s=connect_timeout_s):
+        out[i] = value
+        if not ok:
+            failed.append((i, value))
     if failed and errors == "raise":
         i, exc = min(failed, key=lambda x: x[0])
         raise BatchError(f"{len(failed)} of {len(specs)} runs failed; first: run {i}: "
@@ -399,6 +248,15 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
     return out
 
 
-__all__ = ["run_batch", "run_chunk", "make_pool", "SerialPool", "LocalPool", "DaskPool", "BatchError",
-           "DistributedMissing", "specs_product", "as_spec", "warm_up", "available_cores",
-           "auto_chunk_size", "chunked"]
+def __getattr__(name: str):
+    if name == "WarmUpPlugin":  # created on first use (distributed is optional)
+        from . import dask_pool
+
+        return dask_pool.WarmUpPlugin
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["run_batch", "iter_batch", "run_chunk", "make_pool", "SerialPool", "LocalPool", "DaskPool",
+           "BatchError", "SchedulerError", "DistributedMissing", "specs_product", "as_spec", "warm_up",
+           "available_cores", "auto_chunk_size", "chunked", "Compact", "CompactResult", "compact_signals",
+           "check_scheduler", "FLOAT64_SIGNALS"]

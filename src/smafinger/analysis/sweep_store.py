@@ -1,0 +1,189 @@
+"""Sweep storage: durable part files, resume, and a streaming merge into the final table.
+
+- Every file is written under a temporary name (``.NAME.HOST-PID.RANDOM.tmp``), flushed to
+  disk (``fsync``), renamed, and its folder flushed too, so a finished part survives a
+  crash or a power cut. Temporaries left by a killed process are removed by the next run:
+  only names of this pattern, and only those whose process (on this host) is gone.
+- Finished runs go to ``OUT.parts/part-*.parquet`` (and ``part-*.traces.parquet``, written
+  first); the rows file is the 'done' mark.
+- Which runs are finished, and the merge into ``OUT``: :mod:`.sweep_merge`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import socket
+import time
+import uuid
+from pathlib import Path
+
+import numpy as np
+
+META_KEY = b"smafinger.sweep"
+#: points per row group of the table, and the most trace samples per row group of the traces
+TABLE_BLOCK = 65_536
+TRACE_BLOCK_SAMPLES = 1_000_000
+#: a temporary of an older smafinger (no host or pid in its name) is stale after this long
+LEGACY_TMP_AGE_S = 3600.0
+_HOST = re.sub(r"[^A-Za-z0-9_]", "_", socket.gethostname())[:40] or "host"
+
+
+class StoreError(ValueError):
+    """The output file is not a sweep table (never overwritten)."""
+
+
+# ---------------------------------------------------------------------------------------
+# durable files
+# ---------------------------------------------------------------------------------------
+def parts_dir(out: Path) -> Path:
+    return out.with_name(out.name + ".parts")
+
+
+def traces_path(out: Path) -> Path:
+    """``results.parquet`` -> ``results.traces.parquet``."""
+    return out.with_name(out.stem + ".traces" + out.suffix)
+
+
+def temp_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{_HOST}-{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+
+
+def fsync_dir(folder: Path) -> None:
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:  # pragma: no cover - platforms without directory handles
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # pragma: no cover
+        pass
+    finally:
+        os.close(fd)
+
+
+def durable_replace(tmp: Path, path: Path) -> None:
+    """Flush ``tmp`` to disk, rename it to ``path``, flush the folder."""
+    with open(tmp, "rb+") as f:
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+    fsync_dir(path.parent)
+
+
+def durable_write(path: Path, write) -> None:
+    """``write(tmp)`` then :func:`durable_replace`; the temporary is removed on any error."""
+    tmp = temp_path(path)
+    try:
+        write(str(tmp))
+        durable_replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    return True
+
+
+def clean_stale_temporaries(folder: Path, names: list[str], now: float | None = None) -> list[Path]:
+    """Remove our temporaries of ``names`` (regular expressions) in ``folder`` whose writer
+    is gone; returns them.
+
+    Ours: ``.NAME.HOST-PID.XXXXXXXX.tmp`` (removed if HOST is this host and PID is not a
+    live process) and ``.NAME.XXXXXXXXXXXX.tmp`` of older versions (removed after
+    :data:`LEGACY_TMP_AGE_S`). Nothing else is touched.
+    """
+    if not folder.is_dir():
+        return []
+    now = time.time() if now is None else now
+    alt = "|".join(names)
+    ours = re.compile(rf"^\.(?:{alt})\.(?P<host>[A-Za-z0-9_]+)-(?P<pid>\d+)\.[0-9a-f]{{8}}\.tmp$")
+    legacy = re.compile(rf"^\.(?:{alt})\.[0-9a-f]{{12}}\.tmp$")
+    removed = []
+    for f in folder.iterdir():
+        m = ours.match(f.name)
+        if m:
+            stale = m["host"] == _HOST and not _pid_alive(int(m["pid"]))
+        else:
+            try:
+                stale = bool(legacy.match(f.name)) and now - f.stat().st_mtime > LEGACY_TMP_AGE_S
+            except OSError:
+                stale = False
+        if stale:
+            try:
+                f.unlink()
+                removed.append(f)
+            except OSError:
+                pass
+    return removed
+
+
+PART_NAMES = [r"part-\d{20}-[0-9a-f]{8}(?:\.traces)?\.parquet"]
+
+
+def clean_stale(out: Path) -> list[Path]:
+    """:func:`clean_stale_temporaries` for ``OUT``, its traces and its parts."""
+    names = [re.escape(out.name), re.escape(traces_path(out).name)]
+    removed = clean_stale_temporaries(out.parent, names)
+    pdir = parts_dir(out)
+    removed += clean_stale_temporaries(pdir, PART_NAMES)
+    return removed
+
+
+# ---------------------------------------------------------------------------------------
+# parts
+# ---------------------------------------------------------------------------------------
+def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
+    """One part: ``part-<time>-<uid>.parquet`` (+ ``.traces.parquet``, written first), each durable."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    if not pdir.is_dir():
+        pdir.mkdir()
+        fsync_dir(pdir.parent)
+    stem = f"part-{time.time_ns():020d}-{uuid.uuid4().hex[:8]}"
+    if traces is not None:
+        ttab = pa.table(traces)
+        durable_write(pdir / f"{stem}.traces.parquet", lambda tmp: pq.write_table(ttab, tmp))
+    tab = pa.Table.from_pylist(rows)
+    path = pdir / f"{stem}.parquet"
+    durable_write(path, lambda tmp: pq.write_table(tab, tmp))
+    return path
+
+
+def read_meta(path: Path) -> dict | None:
+    import pyarrow.parquet as pq
+
+    meta = pq.read_schema(path).metadata or {}
+    if META_KEY not in meta:
+        return None
+    return json.loads(meta[META_KEY])
+
+
+def _ids(column) -> np.ndarray:
+    return np.asarray(column.to_numpy(zero_copy_only=False), dtype=object).astype("S16")
+
+
+class IdIndex:
+    """Run id -> point of the current sweep (ids in point order, ``S16``)."""
+
+    def __init__(self, ids: np.ndarray):
+        self.ids = ids
+        self._order = np.argsort(ids, kind="stable")
+        self._sorted = ids[self._order]
+
+    def points(self, ids: np.ndarray) -> np.ndarray:
+        """The point of each id, -1 for ids not in the sweep."""
+        if len(self._sorted) == 0 or len(ids) == 0:
+            return np.full(len(ids), -1, dtype=np.int64)
+        k = np.searchsorted(self._sorted, ids)
+        k = np.minimum(k, len(self._sorted) - 1)
+        hit = self._sorted[k] == ids
+        return np.where(hit, self._order[k], -1).astype(np.int64)
