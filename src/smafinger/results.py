@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from .engine.kernel import OUT_COLUMNS
+from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
 #: exported column -> (kernel column, scale)
 EXPORT_COLUMNS: dict[str, tuple[str, float]] = {
@@ -159,65 +160,23 @@ def segment_bounds(result: SimulationResult) -> list[tuple[int, float, float]]:
     return out
 
 
-def time_to_reach(t, theta_deg, target_deg, start, end, tol_deg, hold_s):
-    """From samples: first time (from ``start``) after which theta stays within tol for ``hold_s``.
-
-    None if that never happens inside [start, end]. (The metrics use the engine's own
-    record, made at every step boundary; this is the same rule on sampled signals, for
-    measured data.)
-    """
-    eps = 1e-9
-    m = (t >= start - eps) & (t <= end + eps)
-    ts = t[m]
-    inside = np.abs(theta_deg[m] - target_deg) <= tol_deg + 1e-12
-    if not inside.any():
-        return None
-    # start of each run of consecutive 'inside' samples
-    idx = np.flatnonzero(inside)
-    breaks = np.flatnonzero(np.diff(idx) > 1)
-    run_first = np.concatenate(([idx[0]], idx[breaks + 1]))
-    run_last = np.concatenate((idx[breaks], [idx[-1]]))
-    for f, l in zip(run_first, run_last):
-        if ts[l] - ts[f] >= hold_s - eps:
-            return float(ts[f] - start)
-    return None
-
-
 def compute_metrics(result: SimulationResult) -> dict:
+    """The run's metrics (:func:`smafinger.metrics.run_metrics`) with its reach settings and
+    interlock count."""
+    from .metrics import Span, run_metrics
+
     spec = result.spec
-    t = result.t
-    th = result.signal("theta_deg")
-    Tu, Tl = result.raw("T_u"), result.raw("T_l")
-    su, sl = result.raw("sigma_u"), result.raw("sigma_l")
-    Eu, El = result.raw("E_u"), result.raw("E_l")
-    segments = []
+    spans = []
     for i, start, end in segment_bounds(result):
         seg = spec.profile.segments[i]
-        m = (t >= start - 1e-12) & (t <= end + 1e-12)
-        k0 = int(np.searchsorted(t, start - 1e-12))
-        k1 = min(int(np.searchsorted(t, end - 1e-12)), len(t) - 1)
-        th0 = th[k0]
-        direction = np.sign(seg.target_deg - th0)
-        over = 0.0
-        if direction != 0 and m.any():
-            over = max(0.0, float(np.max(direction * (th[m] - seg.target_deg))))
-        segments.append({
-            "index": i,
-            "start_s": start,
-            "end_s": end,
-            "target_deg": seg.target_deg,
-            "enable": seg.enable,
-            "reached_s": None if math.isnan(result.segment_reached_s[i]) else float(result.segment_reached_s[i]),
-            "overshoot_deg": over,
-            "energy_J": {"upper": float(Eu[k1] - Eu[k0]), "lower": float(El[k1] - El[k0])},
-            "peak_temperature_C": {"upper": float(np.max(Tu[m])), "lower": float(np.max(Tl[m]))},
-        })
-    return {
-        "segments": segments,
-        "tol_deg": spec.tol_deg,
-        "hold_s": spec.hold_s,
-        "energy_J": {"upper": float(Eu[-1]), "lower": float(El[-1])},
-        "peak_temperature_C": {"upper": float(np.max(Tu)), "lower": float(np.max(Tl))},
-        "peak_stress_Pa": {"upper": float(np.max(su)), "lower": float(np.max(sl))},
-        "interlock_violations": result.interlock_violations,
-    }
+        reached = result.segment_reached_s[i]
+        spans.append(Span(i, start, end, seg.target_deg, seg.enable,
+                          None if math.isnan(reached) else float(reached)))
+    wires = ("upper", "lower")
+    m = run_metrics(result.t, result.signal("theta_deg"), spans,
+                    temperature_C={w: result.signal(f"T_{w}_C") for w in wires},
+                    stress_Pa={w: result.signal(f"sigma_{w}_Pa") for w in wires},
+                    energy_J={"upper": result.raw("E_u"), "lower": result.raw("E_l")})
+    return {"segments": m["segments"], "tol_deg": spec.tol_deg, "hold_s": spec.hold_s,
+            "energy_J": m["energy_J"], "peak_temperature_C": m["peak_temperature_C"],
+            "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations}
