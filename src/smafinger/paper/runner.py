@@ -6,7 +6,7 @@ worker processes, then writes into the output directory:
 - one PNG per figure (``fig07-cdf.png``, ``fig08-h0.png``, ...);
 - ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms);
 - ``summary.json``: per scenario, its definition, ``result.summary()`` and its figure
-  metrics (``derived``);
+  metrics (``derived``), both computed in the worker from the full 1 ms output;
 - ``investigation.json``: the Fig. 15 readings (when both on-reach Fig. 15 scenarios ran);
 - ``report.md``: each claim beside smafinger's value and verdict (:mod:`.report`).
 
@@ -32,7 +32,7 @@ from ..results import SimulationResult, atomic_write
 from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
-from .derived import Run, derive
+from .derived import Derivation, Run, derive
 from .fig15 import REACH
 from .report import write_report
 
@@ -43,29 +43,47 @@ EVERY = 10
 JSON_DIGITS = 12
 
 
-def _thin(result: SimulationResult, every: int) -> SimulationResult:
-    """Worker side: the result with its metrics computed at full resolution, then thinned to
-    every ``every``-th sample (small to send back and to store)."""
-    metrics = result.metrics
-    return dataclasses.replace(result, data=np.ascontiguousarray(result.data[::every]), _metrics=metrics)
+@dataclass(frozen=True)
+class _ThinAndDerive:
+    """Worker side: a run's figure metrics computed at full resolution (every derivation
+    named for its spec), then the result thinned to every ``every``-th sample, its metrics
+    kept (small to send back and to store)."""
+
+    every: int
+    derivations: tuple[tuple[RunSpec, Derivation | None], ...]
+
+    def __call__(self, result: SimulationResult) -> tuple[SimulationResult, dict]:
+        named = {d for spec, d in self.derivations if spec == result.spec}
+        if not named:
+            raise LookupError("no figure metrics are named for this run's spec")
+        derived = {d: derive(d, result) for d in named}
+        metrics = result.metrics
+        thin = dataclasses.replace(result, data=np.ascontiguousarray(result.data[::self.every]), _metrics=metrics)
+        return thin, derived
 
 
 def run_tasks(tasks: list[tuple[str, RunSpec]], workers: int | None = None,
-              on_done: Callable[[str], None] | None = None) -> dict[str, Run]:
-    """Run ``(key, spec)`` tasks on a pool; a failed run is kept with its error."""
-    from functools import partial
+              on_done: Callable[[str], None] | None = None,
+              derivations: dict[str, Derivation | None] | None = None) -> dict[str, Run]:
+    """Run ``(key, spec)`` tasks on a pool; a failed run is kept with its error.
 
+    ``derivations`` names each key's figure metrics (default: none), computed in the worker
+    from the full-resolution output like ``summary``.
+    """
     from ..engine.batch import chunked, make_pool
 
+    named = derivations or {}
     specs = dict(tasks)
+    reduce = _ThinAndDerive(EVERY, tuple((spec, named.get(key)) for key, spec in tasks))
     out: dict[str, Run] = {}
     with make_pool(workers) as pool:
         # longest runs first, one run per task: the pool stays busy to the end
         order = sorted(tasks, key=lambda kv: -kv[1].t_end_s)
-        for outcomes in pool.map_chunks(chunked(order, 1), partial(_thin, every=EVERY)):
+        for outcomes in pool.map_chunks(chunked(order, 1), reduce):
             for key, ok, value in outcomes:
                 if ok:
-                    out[key] = Run(key, specs[key], value, value.summary())
+                    thin, derived = value
+                    out[key] = Run(key, specs[key], thin, thin.summary(), derived[named.get(key)])
                 else:
                     out[key] = Run(key, specs[key], None, None, error=f"{type(value).__name__}: {value}")
                 if on_done is not None:
@@ -121,24 +139,16 @@ class ReproduceOutput:
     failed: list[str] = field(default_factory=list)
 
 
-def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress: bool) -> dict[str, Run]:
+def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress: bool,
+              derivations: dict[str, Derivation | None]) -> dict[str, Run]:
     if not progress:
-        return run_tasks(tasks, workers)
+        return run_tasks(tasks, workers, derivations=derivations)
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     with Progress(TextColumn("[bold]reproduce[/bold] {task.description}"), BarColumn(),
                   MofNCompleteColumn(), TimeElapsedColumn(), transient=True) as bar:
         task = bar.add_task("simulating", total=len(tasks))
-        return run_tasks(tasks, workers, lambda key: bar.update(task, advance=1, description=key))
-
-
-def _finish(runs: dict[str, Run], chosen: list[scn.Scenario]) -> None:
-    """Attach each run's scenario and compute its figure metrics."""
-    by_name = {s.name: s for s in chosen}
-    for key, r in runs.items():
-        r.scenario = by_name.get(key)
-        if r.ok:
-            r.derived = derive(r.scenario.derive if r.scenario else inv.DERIVE, r.result)
+        return run_tasks(tasks, workers, lambda key: bar.update(task, advance=1, description=key), derivations)
 
 
 def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
@@ -186,8 +196,11 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     n_workers = max(1, min(workers or available_cores(), len(tasks)))
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
-    runs = _simulate(tasks, n_workers, progress)
-    _finish(runs, chosen)
+    derivations = {k: inv.DERIVE for k, _ in tasks}
+    derivations.update({s.name: s.derive for s in chosen})
+    runs = _simulate(tasks, n_workers, progress, derivations)
+    for s in chosen:
+        runs[s.name].scenario = s
     scen_runs = {n: runs[n] for n in names}
     _write_runs(out_dir, scen_runs)
     figures = _draw(out_dir, scen_runs)
