@@ -8,11 +8,14 @@ the definitions of :mod:`smafinger.metrics`.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import TYPE_CHECKING, Union
 
 from .. import metrics as M
 from ..engine.run import RunSpec
 from ..results import SimulationResult
+
+if TYPE_CHECKING:  # the scenario names its derivation: no import at run time
+    from .scenario import Scenario
 
 WIRES = ("upper", "lower")
 
@@ -102,7 +105,7 @@ class Run:
     summary: dict | None
     derived: dict | None = None
     error: str | None = None
-    scenario: Any = None
+    scenario: "Scenario | None" = None
 
     @property
     def ok(self) -> bool:

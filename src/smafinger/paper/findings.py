@@ -8,13 +8,13 @@ change, which reading comes closest) is evaluated on the numbers of
 from __future__ import annotations
 
 from .claim import between, known, within
-from .fig15 import PAPER_REDUCTION, PAPER_S, REDUCTION_BAND, TIME_TOLERANCE
+from .fig15 import PAPER_REDUCTION, PAPER_S, REDUCTION_BAND, STRATEGY_NAMES, TIME_TOLERANCE
 from .fmt import pct, secs, span
 from .investigation import READINGS, T_END_S
 from .scenario import MOVE_S
 
-STRATEGIES = ("independent", "cooperative")
-NAMES = {"independent": "independent", "cooperative": "co-operative"}
+STRATEGIES = tuple(STRATEGY_NAMES)
+NAMES = STRATEGY_NAMES
 
 
 def _pair(r: dict) -> str:
