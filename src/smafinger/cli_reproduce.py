@@ -23,7 +23,8 @@ def reproduce(
     from rich.console import Console
     from rich.table import Table
 
-    from .reproduce import reproduce as run
+    from .paper.claim import Verdict
+    from .paper.runner import reproduce as run
 
     if workers is not None and workers < 1:
         raise ValueError(f"--workers {workers}: must be >= 1")
@@ -33,9 +34,15 @@ def reproduce(
     table = Table(title=f"Gilardi et al. (2010) reproduced: {len(res.runs)} runs in {res.wall_s:.1f} s")
     for col in ("Figure", "Claim", "Paper", "Holds"):
         table.add_column(col, overflow="fold")
-    for c in res.claims:
-        table.add_row(c.figure, c.claim, c.paper, c.holds)
+    skipped = 0
+    for o in res.claims:
+        if o.verdict is Verdict.NOT_RUN:
+            skipped += 1
+            continue
+        table.add_row(o.claim.figure, o.claim.statement, o.claim.paper, o.verdict.value)
     console.print(table)
+    if skipped:
+        console.print(f"{skipped} claim(s) not run: their scenarios were not selected")
     console.print(f"smafinger's values, notes and the full-cycle investigation: {res.out_dir / 'report.md'}")
     console.print(f"figures, runs/*.csv and summary.json in {res.out_dir}/")
     if res.failed:
@@ -47,7 +54,7 @@ def scenarios_cmd(
     verbose: bool = typer.Option(False, "--verbose", "-v", help="also print each scenario's description and settings"),
 ):
     """List the named scenarios (name and the figure it reproduces)."""
-    from . import scenarios
+    from .paper import scenarios
 
     for s in scenarios.all_scenarios():
         typer.echo(f"{s.name:34s} {s.figure}")
@@ -55,4 +62,4 @@ def scenarios_cmd(
             typer.echo(f"    {s.description}")
             how = f"profile {s.profile!r}" if s.profile else f"voltage {s.voltage!r}"
             typer.echo(f"    params {s.params}, strategy {s.strategy}, {how}, {s.t_end_s:g} s"
-                       + (f", overrides {' '.join(s.overrides)}" if s.overrides else ""))
+                       + (f", overrides {' '.join(s.overrides.texts())}" if s.overrides.texts() else ""))

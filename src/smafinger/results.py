@@ -13,6 +13,7 @@ import numpy as np
 
 from .engine.signals import columns
 from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older imports)
+from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
 
 @dataclass
@@ -135,65 +136,24 @@ def segment_bounds(result: SimulationResult) -> list[tuple[int, float, float]]:
     return out
 
 
-def time_to_reach(t, theta_deg, target_deg, start, end, tol_deg, hold_s):
-    """From samples: first time (from ``start``) after which theta stays within tol for ``hold_s``.
-
-    None if that never happens inside [start, end]. (The metrics use the engine's own
-    record, made at every step boundary; this is the same rule on sampled signals, for
-    measured data.)
-    """
-    eps = 1e-9
-    m = (t >= start - eps) & (t <= end + eps)
-    ts = t[m]
-    inside = np.abs(theta_deg[m] - target_deg) <= tol_deg + 1e-12
-    if not inside.any():
-        return None
-    # start of each run of consecutive 'inside' samples
-    idx = np.flatnonzero(inside)
-    breaks = np.flatnonzero(np.diff(idx) > 1)
-    run_first = np.concatenate(([idx[0]], idx[breaks + 1]))
-    run_last = np.concatenate((idx[breaks], [idx[-1]]))
-    for f, l in zip(run_first, run_last):
-        if ts[l] - ts[f] >= hold_s - eps:
-            return float(ts[f] - start)
-    return None
-
-
 def compute_metrics(result: SimulationResult) -> dict:
+    """The run's metrics (:func:`smafinger.metrics.run_metrics`) with its reach settings and
+    interlock count."""
+    from .metrics import Span, run_metrics
+
     spec = result.spec
     p = spec.params
     unit = p.coordinate.unit
-    names = p.wire_names
-    t = result.t
-    q = result.signal(f"{p.coordinate.name}_{unit}")
-    T, sigma, E = result.wires["T"], result.wires["sigma"], result.wires["energy"]
-    segments = []
+    wires = p.wire_names
+    spans = []
     for i, start, end in segment_bounds(result):
         seg = spec.profile.segments[i]
-        m = (t >= start - 1e-12) & (t <= end + 1e-12)
-        k0 = int(np.searchsorted(t, start - 1e-12))
-        k1 = min(int(np.searchsorted(t, end - 1e-12)), len(t) - 1)
-        direction = np.sign(seg.target - q[k0])
-        over = 0.0
-        if direction != 0 and m.any():
-            over = max(0.0, float(np.max(direction * (q[m] - seg.target))))
-        segments.append({
-            "index": i,
-            "start_s": start,
-            "end_s": end,
-            f"target_{unit}": seg.target,
-            "enable": seg.enable,
-            "reached_s": None if math.isnan(result.segment_reached_s[i]) else float(result.segment_reached_s[i]),
-            f"overshoot_{unit}": over,
-            "energy_J": {w: float(E[k1, j] - E[k0, j]) for j, w in enumerate(names)},
-            "peak_temperature_C": {w: float(np.max(T[m, j])) for j, w in enumerate(names)},
-        })
-    return {
-        "segments": segments,
-        f"tol_{unit}": spec.tolerance,
-        "hold_s": spec.hold_s,
-        "energy_J": {w: float(E[-1, j]) for j, w in enumerate(names)},
-        "peak_temperature_C": {w: float(np.max(T[:, j])) for j, w in enumerate(names)},
-        "peak_stress_Pa": {w: float(np.max(sigma[:, j])) for j, w in enumerate(names)},
-        "interlock_violations": result.interlock_violations,
-    }
+        reached = result.segment_reached_s[i]
+        spans.append(Span(i, start, end, seg.target, seg.enable, None if math.isnan(reached) else float(reached)))
+    m = run_metrics(result.t, result.signal(f"{p.coordinate.name}_{unit}"), spans,
+                    temperature_C={w: result.signal(f"T_{w}_C") for w in wires},
+                    stress_Pa={w: result.signal(f"sigma_{w}_Pa") for w in wires},
+                    energy_J={w: result.signal(f"energy_{w}_J") for w in wires}, unit=unit)
+    return {"segments": m["segments"], f"tol_{unit}": spec.tolerance, "hold_s": spec.hold_s,
+            "energy_J": m["energy_J"], "peak_temperature_C": m["peak_temperature_C"],
+            "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations}

@@ -1,0 +1,308 @@
+"""Every metric of a run, defined once: times in s, angles in deg, on sampled signals.
+
+The functions take plain arrays (a run's output or measured data), so the same definition
+serves :func:`smafinger.results.compute_metrics`, the paper layer
+(:mod:`smafinger.paper`) and the sweeps. Each threshold is a named constant below and an
+argument of the function that uses it.
+
+Conventions
+-----------
+- A sample belongs to a time window ``[start, end]`` if it lies within :data:`EDGE_S`
+  (half a tick of the engine's 1 ns clock) of it: run times are whole ticks.
+- Overshoot is measured in the direction of the motion: from where the joint was when the
+  move started, towards the target and beyond it (:func:`overshoot_deg`).
+- ``None`` means "never" (a time that did not happen in the run).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+import numpy as np
+
+from .engine.run import TICK_S
+
+#: a sample belongs to a window if within this of its edges (half a clock tick) [s]
+EDGE_S = 0.5 * TICK_S
+#: the joint has started to move once this far from its reference angle [deg]
+START_OF_MOTION_DEG = 0.1
+#: "rise" and "return" times: the first time this fraction of the way is covered
+WAY_FRACTION = 0.9
+#: open loop: "still moving" is the mean speed over this last part of the heating [s]
+STILL_WINDOW_S = 1.0
+#: settling time: the joint stays within this band of the target [deg]
+SETTLE_BAND_DEG = 0.1
+#: a wire is back to martensite once its martensite fraction reaches this
+MARTENSITE_XI = 0.999
+#: cooling phase: the overshoot after it is looked for within this time [s]
+COOLING_WINDOW_S = 5.0
+#: angle comparisons with a tolerance allow this much rounding [deg]
+ANGLE_EPS_DEG = 1e-12
+
+
+# ---------------------------------------------------------------------------------------
+# building blocks
+# ---------------------------------------------------------------------------------------
+def window(t: np.ndarray, start_s: float = -math.inf, end_s: float = math.inf) -> np.ndarray:
+    """Mask of the samples in ``[start_s, end_s]`` (edges within :data:`EDGE_S`)."""
+    return (t >= start_s - EDGE_S) & (t <= end_s + EDGE_S)
+
+
+def first_time(mask: np.ndarray, t: np.ndarray) -> float | None:
+    """Time of the first sample where ``mask`` is true; ``None`` if there is none."""
+    idx = np.flatnonzero(mask)
+    return float(t[idx[0]]) if idx.size else None
+
+
+def motion_direction(from_deg: float, target_deg: float) -> float:
+    """+1 towards a larger angle, -1 towards a smaller one, 0 if already there."""
+    return float(np.sign(target_deg - from_deg))
+
+
+def overshoot_deg(theta_deg: np.ndarray, target_deg: float, direction: float) -> float:
+    """How far the joint went past ``target_deg`` in ``direction`` (>= 0; 0 if it did not).
+
+    The one definition of overshoot: ``max(0, max(direction * (theta - target)))``.
+    """
+    if direction == 0 or theta_deg.size == 0:
+        return 0.0
+    return max(0.0, float(np.max(direction * (theta_deg - target_deg))))
+
+
+def motion_start_s(t: np.ndarray, theta_deg: np.ndarray, threshold_deg: float = START_OF_MOTION_DEG,
+                   reference_deg: float | None = None) -> float | None:
+    """First time the joint is more than ``threshold_deg`` from ``reference_deg``.
+
+    ``reference_deg`` defaults to the first sample's angle. ``None`` if it never moves.
+    """
+    if t.size == 0:
+        return None
+    ref = float(theta_deg[0]) if reference_deg is None else reference_deg
+    return first_time(np.abs(theta_deg - ref) > threshold_deg, t)
+
+
+def settle_time(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s: float,
+                end_s: float, band_deg: float = SETTLE_BAND_DEG) -> float | None:
+    """Time from ``start_s`` after which ``|theta - target| <= band_deg`` until ``end_s``.
+
+    0 if always inside; ``None`` if the joint is still outside at ``end_s``.
+    """
+    m = window(t, start_s, end_s)
+    ts, th = t[m], theta_deg[m]
+    out = np.abs(th - target_deg) > band_deg
+    if not out.any():
+        return 0.0
+    k = int(np.flatnonzero(out)[-1])
+    if k == len(ts) - 1:
+        return None
+    return float(ts[k + 1] - start_s)
+
+
+def time_to_reach(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s: float,
+                  end_s: float, tol_deg: float, hold_s: float) -> float | None:
+    """First time (from ``start_s``) after which theta stays within ``tol_deg`` for ``hold_s``.
+
+    The engine's "reached" rule applied to sampled signals (e.g. measured data); the
+    engine itself records it at every step. ``None`` if it never happens in the window.
+    """
+    m = window(t, start_s, end_s)
+    ts = t[m]
+    inside = np.abs(theta_deg[m] - target_deg) <= tol_deg + ANGLE_EPS_DEG
+    if not inside.any():
+        return None
+    idx = np.flatnonzero(inside)
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    run_first = np.concatenate(([idx[0]], idx[breaks + 1]))
+    run_last = np.concatenate((idx[breaks], [idx[-1]]))
+    for f, last in zip(run_first, run_last):
+        if ts[last] - ts[f] >= hold_s - EDGE_S:
+            return float(ts[f] - start_s)
+    return None
+
+
+def martensite_time(t: np.ndarray, xi: np.ndarray, start_s: float,
+                    full_xi: float = MARTENSITE_XI) -> float | None:
+    """Time from ``start_s`` until the wire is back to martensite (``xi >= full_xi``).
+
+    ``None`` if it already was at ``start_s`` (no cooling to wait for) or never gets there.
+    """
+    m = window(t, start_s)
+    was = float(xi[m][0]) if m.any() else 1.0
+    hit = first_time(m & (xi >= full_xi), t)
+    return None if was >= full_xi or hit is None else hit - start_s
+
+
+def increase(t: np.ndarray, cumulative: np.ndarray, start_s: float, end_s: float) -> float:
+    """Increase of a cumulative signal (e.g. energy) from ``start_s`` to ``end_s``."""
+    k0 = int(np.searchsorted(t, start_s - EDGE_S))
+    k1 = min(int(np.searchsorted(t, end_s - EDGE_S)), len(t) - 1)
+    return float(cumulative[k1] - cumulative[k0])
+
+
+# ---------------------------------------------------------------------------------------
+# open loop (Sec. 3.1) and the cooling phase (Sec. 2.6, Fig. 11)
+# ---------------------------------------------------------------------------------------
+def openloop_metrics(t: np.ndarray, theta_deg: np.ndarray, t_off_s: float,
+                     move_deg: float = START_OF_MOTION_DEG, fraction: float = WAY_FRACTION,
+                     still_window_s: float = STILL_WINDOW_S) -> dict:
+    """Range, start and speed of an open-loop run heated until ``t_off_s`` (Sec. 3.1).
+
+    Returns ``range_deg`` (largest ``|theta - theta(0)|`` while heated), ``start_s`` (first
+    time it has moved ``move_deg``), ``rise90_s`` (first time it covers ``fraction`` of its
+    range), ``still_moving_deg_s`` (mean speed over the last ``still_window_s`` of heating),
+    ``angle_at_off_deg``, ``final_deg`` (last sample), and, from ``t_off_s``,
+    ``return_start_s`` (moved ``move_deg`` back) and ``return90_s`` (covered ``fraction`` of
+    the way from ``angle_at_off_deg`` to ``final_deg``).
+    """
+    d = np.abs(theta_deg - float(theta_deg[0]))
+    heat = window(t, end_s=t_off_s)
+    cool = ~heat
+    rng = float(np.max(d[heat]))
+    k_off = int(np.flatnonzero(heat)[-1])
+    k_still = int(np.searchsorted(t, t_off_s - still_window_s - EDGE_S))
+    span = max(EDGE_S, float(t[k_off] - t[k_still]))
+    still = abs(float(theta_deg[k_off] - theta_deg[k_still])) / span
+    th_off, th_end = float(theta_deg[k_off]), float(theta_deg[-1])
+    way = abs(th_off - th_end)
+    moved = rng >= move_deg
+    ret_start = motion_start_s(t[cool], theta_deg[cool], move_deg, reference_deg=th_off)
+    ret90 = (first_time(cool & (np.abs(theta_deg - th_end) <= (1.0 - fraction) * way), t)
+             if way >= move_deg else None)
+    return {
+        "range_deg": rng,
+        "start_s": motion_start_s(t[heat], theta_deg[heat], move_deg) if moved else None,
+        "rise90_s": first_time(heat & (d >= fraction * rng), t) if moved else None,
+        "still_moving_deg_s": still,
+        "angle_at_off_deg": th_off,
+        "final_deg": th_end,
+        "return_start_s": None if ret_start is None else ret_start - t_off_s,
+        "return90_s": None if ret90 is None else ret90 - t_off_s,
+    }
+
+
+def cooling_phase_metrics(t: np.ndarray, theta_deg: np.ndarray, T_agonist_C: np.ndarray,
+                          target_deg: float, window_s: float = COOLING_WINDOW_S) -> dict:
+    """The agonist's first cooling phase: the joint past ``target_deg`` (Sec. 2.6, Fig. 11).
+
+    "Past" is in the direction of the motion from the first sample. Returned: the phase's
+    ``cooling_start_s`` and duration ``cooling_s``, the mean fall of the agonist's
+    temperature over it ``cooling_rate_C_s``, ``peak_past_deg`` (the overshoot before it
+    ends) and ``overshoot_after_deg`` (the overshoot back the other way within
+    ``window_s`` after it ends). ``None`` values when the joint never passes the target.
+    """
+    direction = motion_direction(float(theta_deg[0]), target_deg)
+    out: dict = {"cooling_start_s": None, "cooling_s": None, "cooling_rate_C_s": None,
+                 "peak_past_deg": overshoot_deg(theta_deg, target_deg, direction),
+                 "overshoot_after_deg": None}
+    past = direction * (theta_deg - target_deg) > 0
+    if direction == 0 or not past.any():
+        return out
+    i0 = int(np.argmax(past))
+    back = np.flatnonzero(~past[i0:])
+    i1 = i0 + int(back[0]) if back.size else len(t) - 1
+    dur = float(t[i1] - t[i0])
+    after = window(t, float(t[i1]), float(t[i1]) + window_s)
+    out.update(cooling_start_s=float(t[i0]), cooling_s=dur,
+               cooling_rate_C_s=float((T_agonist_C[i0] - T_agonist_C[i1]) / dur) if dur > 0 else None,
+               peak_past_deg=overshoot_deg(theta_deg[i0:i1 + 1], target_deg, direction),
+               overshoot_after_deg=(overshoot_deg(theta_deg[after], target_deg, -direction)
+                                    if back.size else None))
+    return out
+
+
+# ---------------------------------------------------------------------------------------
+# per segment and per run (results.compute_metrics)
+# ---------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Span:
+    """One profile segment as it ran: where it started and ended, and its target (in the
+    mechanism's unit: deg for the joint, m for a linear actuator)."""
+
+    index: int
+    start_s: float
+    end_s: float
+    target: float
+    enable: str
+    reached_s: float | None
+
+
+def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
+                    temperature_C: Mapping[str, np.ndarray], energy_J: Mapping[str, np.ndarray],
+                    unit: str = "deg") -> dict:
+    """A segment's reach time, overshoot (in the direction of its move), energy and peak
+    temperature per wire (``energy_J`` are cumulative signals). ``q`` is the joint angle [deg]
+    or a slider's position [m]; ``unit`` names the keys (``target_deg``, ``overshoot_m``)."""
+    m = window(t, span.start_s, span.end_s)
+    k0 = int(np.searchsorted(t, span.start_s - EDGE_S))
+    direction = motion_direction(float(q[k0]), span.target)
+    return {
+        "index": span.index,
+        "start_s": span.start_s,
+        "end_s": span.end_s,
+        f"target_{unit}": span.target,
+        "enable": span.enable,
+        "reached_s": span.reached_s,
+        f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
+        "energy_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()},
+        "peak_temperature_C": {w: float(np.max(T[m])) for w, T in temperature_C.items()},
+    }
+
+
+def run_metrics(t: np.ndarray, q: np.ndarray, spans: Sequence[Span],
+                temperature_C: Mapping[str, np.ndarray], stress_Pa: Mapping[str, np.ndarray],
+                energy_J: Mapping[str, np.ndarray], unit: str = "deg") -> dict:
+    """Per-segment metrics, and each wire's energy, peak temperature and peak stress."""
+    return {
+        "segments": [segment_metrics(t, q, s, temperature_C, energy_J, unit) for s in spans],
+        "energy_J": {w: float(e[-1]) for w, e in energy_J.items()},
+        "peak_temperature_C": {w: float(np.max(T)) for w, T in temperature_C.items()},
+        "peak_stress_Pa": {w: float(np.max(s)) for w, s in stress_Pa.items()},
+    }
+
+
+# ---------------------------------------------------------------------------------------
+# cycles (Fig. 15)
+# ---------------------------------------------------------------------------------------
+def elapsed_time(segments: Sequence[Mapping]) -> float | None:
+    """Time from 0 at which the last target is reached (start of the last segment plus its
+    ``reached_s``); ``None`` if a segment never started or the last target was not reached.
+
+    With targets issued on reach this includes the hold the engine needs to confirm each
+    intermediate target before the next segment starts.
+    """
+    if not segments or segments[-1]["reached_s"] is None or len(segments) != segments[-1]["index"] + 1:
+        return None
+    return float(segments[-1]["start_s"] + segments[-1]["reached_s"])
+
+
+def cycle_time(segments: Sequence[Mapping], n_on_reach: int, hold_s: float) -> float | None:
+    """Full-cycle time (issue 3): :func:`elapsed_time` less the ``hold_s`` spent confirming
+    the target before each of the ``n_on_reach`` segments that start on reach.
+
+    For a profile whose segments after the first all start on reach this is the sum of the
+    segments' ``reached_s``; for a time schedule (``n_on_reach = 0``) it is the elapsed time.
+    """
+    t = elapsed_time(segments)
+    return None if t is None else t - n_on_reach * hold_s
+
+
+def reached_sum(segments: Sequence[Mapping]) -> float | None:
+    """Sum of the segments' ``reached_s``; ``None`` if one was not reached."""
+    rs = [s["reached_s"] for s in segments]
+    return None if not rs or any(r is None for r in rs) else float(sum(rs))
+
+
+def reduction(slower_s: float | None, faster_s: float | None) -> float | None:
+    """Relative time saved: ``(slower - faster) / slower``; ``None`` if either is missing."""
+    return None if slower_s is None or faster_s is None else (slower_s - faster_s) / slower_s
+
+
+__all__ = [
+    "EDGE_S", "START_OF_MOTION_DEG", "WAY_FRACTION", "STILL_WINDOW_S", "SETTLE_BAND_DEG",
+    "MARTENSITE_XI", "COOLING_WINDOW_S", "window", "first_time", "motion_direction",
+    "overshoot_deg", "motion_start_s", "settle_time", "time_to_reach", "martensite_time",
+    "increase", "openloop_metrics", "cooling_phase_metrics", "Span", "segment_metrics",
+    "run_metrics", "elapsed_time", "cycle_time", "reached_sum", "reduction",
+]

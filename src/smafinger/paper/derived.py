@@ -1,0 +1,121 @@
+"""A scenario's figure metrics (the numbers its claims read), and a finished run.
+
+Each scenario names the figure metrics it needs with one of the typed derivations below;
+:func:`derive` computes them from a :class:`~smafinger.results.SimulationResult` with
+the definitions of :mod:`smafinger.metrics`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Union
+
+from .. import metrics as M
+from ..engine.run import RunSpec
+from ..results import SimulationResult
+
+if TYPE_CHECKING:  # the scenario names its derivation: no import at run time
+    from .scenario import Scenario
+
+WIRES = ("upper", "lower")
+
+
+def cycle_metrics(result: SimulationResult) -> dict:
+    """A closed-loop run's cycle times: ``cycle_s`` (:func:`~smafinger.metrics.cycle_time`),
+    ``elapsed_s`` (time from 0) and ``reached_sum_s``."""
+    segs = result.summary()["segments"]
+    n_on_reach = sum(1 for s in result.spec.profile.segments if s.start_s is None)
+    return {"cycle_s": M.cycle_time(segs, n_on_reach, result.spec.hold_s),
+            "elapsed_s": M.elapsed_time(segs), "reached_sum_s": M.reached_sum(segs)}
+
+
+def segment_detail(result: SimulationResult, index: int) -> dict:
+    """A segment's target, start, reach time and overshoot (from the run's metrics), its
+    settling time, when each wire got back to martensite, and each wire's peak duty."""
+    seg = next(s for s in result.summary()["segments"] if s["index"] == index)
+    t, th = result.t, result.signal("theta_deg")
+    inside = M.window(t, seg["start_s"], seg["end_s"])
+    out = {k: seg[k] for k in ("target_deg", "start_s", "reached_s", "overshoot_deg")}
+    out["settle_s"] = M.settle_time(t, th, seg["target_deg"], seg["start_s"], seg["end_s"])
+    for w in WIRES:
+        out[f"martensite_{w}_s"] = M.martensite_time(t, result.signal(f"xi_{w}"), seg["start_s"])
+        out[f"peak_duty_{w}"] = float(result.signal(f"duty_{w}")[inside].max())
+    return out
+
+
+@dataclass(frozen=True)
+class OpenLoop:
+    """Open loop, heated until ``t_off_s`` then cooling (Sec. 3.1):
+    :func:`~smafinger.metrics.openloop_metrics`."""
+
+    t_off_s: float
+
+    def compute(self, result: SimulationResult) -> dict:
+        return M.openloop_metrics(result.t, result.signal("theta_deg"), self.t_off_s)
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """Closed loop: the cycle times (:func:`cycle_metrics`)."""
+
+    def compute(self, result: SimulationResult) -> dict:
+        return cycle_metrics(result)
+
+
+@dataclass(frozen=True)
+class MoveAndReturn:
+    """A move (segment 0) and the return from it (segment ``return_segment``): the cycle
+    times and :func:`segment_detail` of both (keys ``move`` and ``return``)."""
+
+    return_segment: int = 1
+
+    def compute(self, result: SimulationResult) -> dict:
+        return {**cycle_metrics(result), "return": segment_detail(result, self.return_segment),
+                "move": segment_detail(result, 0)}
+
+
+@dataclass(frozen=True)
+class CoolingPhase:
+    """The ``wire``'s first cooling phase, the joint past ``target_deg`` (Fig. 11):
+    the cycle times and :func:`~smafinger.metrics.cooling_phase_metrics` (``cooling_phase``)."""
+
+    target_deg: float
+    wire: str = "upper"
+
+    def compute(self, result: SimulationResult) -> dict:
+        cp = M.cooling_phase_metrics(result.t, result.signal("theta_deg"),
+                                     result.signal(f"T_{self.wire}_C"), self.target_deg)
+        return {**cycle_metrics(result), "cooling_phase": cp}
+
+
+Derivation = Union[OpenLoop, Cycle, MoveAndReturn, CoolingPhase]
+
+
+@dataclass
+class Run:
+    """One finished run: its key, spec, summary, figure metrics and (thinned) result.
+
+    ``summary`` and ``derived`` are computed from the full-resolution output; ``result``
+    is what the CSVs and the figures use. A failed run keeps its ``error``.
+    """
+
+    key: str
+    spec: RunSpec
+    result: SimulationResult | None
+    summary: dict | None
+    derived: dict | None = None
+    error: str | None = None
+    scenario: "Scenario | None" = None
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None
+
+
+def derive(derivation: Derivation | None, result: SimulationResult) -> dict:
+    """The figure metrics ``derivation`` names ({} for none)."""
+    return {} if derivation is None else derivation.compute(result)
+
+
+__all__ = ["OpenLoop", "Cycle", "MoveAndReturn", "CoolingPhase", "Derivation", "Run", "derive",
+           "cycle_metrics", "segment_detail"]

@@ -1,0 +1,215 @@
+"""``smafinger reproduce``: run the paper's scenarios, draw its figures, check its claims.
+
+:func:`reproduce` runs every scenario of :mod:`.scenarios` (or a selection) on a pool of
+worker processes, then writes into the output directory:
+
+- one PNG per figure (``fig07-cdf.png``, ``fig08-h0.png``, ...);
+- ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms);
+- ``summary.json``: per scenario, its definition, ``result.summary()`` and its figure
+  metrics (``derived``), both computed in the worker from the full 1 ms output;
+- ``investigation.json``: the Fig. 15 readings (when both on-reach Fig. 15 scenarios ran);
+- ``report.md``: each claim beside smafinger's value and verdict (:mod:`.report`).
+
+Each file is written atomically; JSON numbers are rounded to :data:`JSON_DIGITS`
+significant digits.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import fnmatch
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+
+from ..engine.run import RunSpec
+from ..results import SimulationResult, atomic_write
+from . import investigation as inv
+from . import scenarios as scn
+from .claim import Outcome
+from .derived import Derivation, Run, derive
+from .fig15 import REACH
+from .report import write_report
+
+#: keep every EVERY-th output sample (1 ms) in the CSVs and the figures (10 ms)
+EVERY = 10
+#: significant digits of the numbers in the JSON outputs: float noise goes, and a time below
+#: 1000 s keeps the engine's 1 ns clock
+JSON_DIGITS = 12
+
+
+@dataclass(frozen=True)
+class _ThinAndDerive:
+    """Worker side: a run's figure metrics computed at full resolution (every derivation
+    named for its spec), then the result thinned to every ``every``-th sample, its metrics
+    kept (small to send back and to store)."""
+
+    every: int
+    derivations: tuple[tuple[RunSpec, Derivation | None], ...]
+
+    def __call__(self, result: SimulationResult) -> tuple[SimulationResult, dict]:
+        named = {d for spec, d in self.derivations if spec == result.spec}
+        if not named:
+            raise LookupError("no figure metrics are named for this run's spec")
+        derived = {d: derive(d, result) for d in named}
+        thin = result.decimated(self.every)  # metrics kept at full resolution
+        return thin, derived
+
+
+def run_tasks(tasks: list[tuple[str, RunSpec]], workers: int | None = None,
+              on_done: Callable[[str], None] | None = None,
+              derivations: dict[str, Derivation | None] | None = None) -> dict[str, Run]:
+    """Run ``(key, spec)`` tasks on a pool; a failed run is kept with its error.
+
+    ``derivations`` names each key's figure metrics (default: none), computed in the worker
+    from the full-resolution output like ``summary``.
+    """
+    from ..engine.batch import chunked, make_pool
+
+    named = derivations or {}
+    specs = dict(tasks)
+    reduce = _ThinAndDerive(EVERY, tuple((spec, named.get(key)) for key, spec in tasks))
+    out: dict[str, Run] = {}
+    with make_pool(workers) as pool:
+        # longest runs first, one run per task: the pool stays busy to the end
+        order = sorted(tasks, key=lambda kv: -kv[1].t_end_s)
+        for outcomes in pool.map_chunks(chunked(order, 1), reduce):
+            for key, ok, value in outcomes:
+                if ok:
+                    thin, derived = value
+                    out[key] = Run(key, specs[key], thin, thin.summary(), derived[named.get(key)])
+                else:
+                    out[key] = Run(key, specs[key], None, None, error=f"{type(value).__name__}: {value}")
+                if on_done is not None:
+                    on_done(key)
+    return {k: out[k] for k, _ in tasks}
+
+
+def select(only: Iterable[str] | None) -> list[scn.Scenario]:
+    """Scenarios named (or matched by a glob pattern) in ``only``; all of them if empty."""
+    if not only:
+        return scn.all_scenarios()
+    chosen: list[str] = []
+    for pat in only:
+        if any(c in pat for c in "*?["):
+            hits = [n for n in scn.names() if fnmatch.fnmatchcase(n, pat)]
+            if not hits:
+                raise ValueError(f"--only {pat!r} matches no scenario (see 'smafinger scenarios')")
+        else:
+            scn.get(pat)  # ValueError naming the known ones
+            hits = [pat]
+        chosen += [h for h in hits if h not in chosen]
+    return [scn.get(n) for n in scn.names() if n in chosen]
+
+
+def json_ready(obj: Any, digits: int = JSON_DIGITS) -> Any:
+    """``obj`` with every float rounded to ``digits`` significant digits, non-finite ones
+    as ``None`` and numpy scalars and arrays as Python values."""
+    if isinstance(obj, dict):
+        return {k: json_ready(v, digits) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [json_ready(v, digits) for v in obj]
+    if isinstance(obj, (np.integer, np.bool_)):
+        return obj.item()
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        return float(f"{x:.{digits}g}") if math.isfinite(x) else None
+    return obj
+
+
+def write_json(path: Path, obj: Any) -> None:
+    text = json.dumps(json_ready(obj), indent=2)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text + "\n"))
+
+
+@dataclass
+class ReproduceOutput:
+    out_dir: Path
+    runs: dict[str, Run]
+    claims: list[Outcome]
+    investigation: list[dict] | None
+    figures: list[Path]
+    wall_s: float
+    failed: list[str] = field(default_factory=list)
+
+
+def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress: bool,
+              derivations: dict[str, Derivation | None]) -> dict[str, Run]:
+    if not progress:
+        return run_tasks(tasks, workers, derivations=derivations)
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(TextColumn("[bold]reproduce[/bold] {task.description}"), BarColumn(),
+                  MofNCompleteColumn(), TimeElapsedColumn(), transient=True) as bar:
+        task = bar.add_task("simulating", total=len(tasks))
+        return run_tasks(tasks, workers, lambda key: bar.update(task, advance=1, description=key), derivations)
+
+
+def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
+    """``runs/NAME.csv`` of every scenario run and ``summary.json``."""
+    summary: dict[str, Any] = {}
+    for name, r in runs.items():
+        entry: dict[str, Any] = {"scenario": r.scenario.definition()}
+        if r.ok:
+            r.result.save(out_dir / "runs" / f"{name}.csv")
+            entry.update(r.summary)
+            entry["derived"] = r.derived
+        else:
+            entry["error"] = r.error
+        summary[name] = entry
+    write_json(out_dir / "summary.json", summary)
+
+
+def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:
+    paths = []
+    for f in scn.FIGURES:
+        sel = [runs[s.name] for s in f.scenarios if s.name in runs]
+        if any(r.ok for r in sel):
+            f.plot(sel, f.title, out_dir / f"{f.key}.png")
+            paths.append(out_dir / f"{f.key}.png")
+    return paths
+
+
+def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
+              progress: bool = False, investigate: bool | None = None) -> ReproduceOutput:
+    """Run the scenarios and write figures, CSVs, summary.json, investigation.json and
+    report.md into ``out_dir``.
+
+    ``only``: scenario names or glob patterns (default: all). ``investigate``: run the Fig. 15
+    readings (default: when both on-reach Fig. 15 scenarios are selected).
+    """
+    from ..engine.batch import available_cores
+
+    t0 = time.perf_counter()
+    out_dir = Path(out_dir)
+    chosen = select(only)  # before anything is written: a bad name leaves no directory
+    names = [s.name for s in chosen]
+    if investigate is None:
+        investigate = all(n in names for n in REACH.values())
+    tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks() if investigate else [])
+    n_workers = max(1, min(workers or available_cores(), len(tasks)))
+    (out_dir / "runs").mkdir(parents=True, exist_ok=True)
+
+    derivations = {k: inv.DERIVE for k, _ in tasks}
+    derivations.update({s.name: s.derive for s in chosen})
+    runs = _simulate(tasks, n_workers, progress, derivations)
+    for s in chosen:
+        runs[s.name].scenario = s
+    scen_runs = {n: runs[n] for n in names}
+    _write_runs(out_dir, scen_runs)
+    figures = _draw(out_dir, scen_runs)
+    rows = inv.table(runs) if investigate else None
+    if rows is not None:
+        write_json(out_dir / "investigation.json", rows)
+    outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
+    wall = time.perf_counter() - t0
+    write_report(out_dir / "report.md", outcomes, rows, runs, figures, wall, n_workers)
+    return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
+
+
+__all__ = ["reproduce", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]

@@ -1,0 +1,149 @@
+"""The metrics of :mod:`smafinger.metrics` on signals whose answer is known."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from smafinger import metrics as M
+
+T = np.round(np.arange(0.0, 20.0 + 1e-9, 1e-3), 9)  # a 1 ms grid, like a run's output
+signals = st.lists(st.floats(-60.0, 60.0, allow_nan=False), min_size=2, max_size=200).map(np.array)
+
+
+# ---- building blocks ------------------------------------------------------------------------
+def test_window_includes_its_edges_within_half_a_tick():
+    t = np.array([0.999999999, 1.0, 2.0, 2.0000000004, 2.000000001])
+    assert M.window(t, 1.0, 2.0).tolist() == [False, True, True, True, False]
+
+
+def test_overshoot_is_measured_in_the_direction_of_the_motion():
+    th = np.array([-40.0, -35.0, -29.5, -30.2, -30.0])
+    assert M.overshoot_deg(th, -30.0, M.motion_direction(-40.0, -30.0)) == pytest.approx(0.5)
+    flexion = np.array([-20.0, -25.0, -30.3, -29.9])
+    assert M.overshoot_deg(flexion, -30.0, M.motion_direction(-20.0, -30.0)) == pytest.approx(0.3)
+    assert M.overshoot_deg(th, -30.0, 0.0) == 0.0
+    assert M.overshoot_deg(np.array([-40.0, -35.0]), -30.0, 1.0) == 0.0
+
+
+@given(signals, st.floats(-60.0, 60.0), st.sampled_from([-1.0, 1.0]))
+def test_overshoot_is_nonnegative_and_mirror_symmetric(th, target, direction):
+    ov = M.overshoot_deg(th, target, direction)
+    assert ov >= 0.0
+    assert M.overshoot_deg(-th, -target, -direction) == ov
+    assert np.all(direction * (th - target) <= ov)
+
+
+def test_motion_start_on_a_ramp():
+    th = -40.0 + 3.0 * T  # 3 deg/s: 0.1 deg after 0.0333 s, 0.5 deg after 0.1667 s
+    assert M.motion_start_s(T, th) == pytest.approx(0.034)
+    assert M.motion_start_s(T, th, threshold_deg=0.5) == pytest.approx(0.167)
+    assert M.motion_start_s(T, np.full_like(T, -40.0)) is None
+
+
+@given(signals, st.floats(0.01, 5.0))
+def test_before_the_start_of_motion_the_joint_is_within_the_threshold(th, thr):
+    t = np.arange(th.size, dtype=float)
+    start = M.motion_start_s(t, th, thr)
+    before = t < (np.inf if start is None else start)
+    assert np.all(np.abs(th[before] - th[0]) <= thr)
+    if start is not None:
+        assert abs(th[int(start)] - th[0]) > thr
+
+
+def test_settle_time_of_a_decaying_oscillation():
+    th = -40.0 + 2.0 * np.exp(-T) * np.cos(2 * np.pi * T)
+    s = M.settle_time(T, th, -40.0, 0.0, 20.0, band_deg=0.1)
+    # the envelope 2 e^-t falls below 0.1 deg at t = ln 20 = 3.0 s; the oscillation is inside sooner
+    assert 2.0 < s <= np.log(20.0) + 1e-3
+    assert np.all(np.abs(th[T >= s] + 40.0) <= 0.1)
+    assert np.abs(th[T < s][-1] + 40.0) > 0.1
+    assert M.settle_time(T, np.full_like(T, -40.0), -40.0, 0.0, 20.0) == 0.0
+    assert M.settle_time(T, -40.0 + T, -40.0, 0.0, 20.0) is None
+
+
+def test_time_to_reach_needs_the_hold():
+    th = np.where(T < 3.0, -40.0 + 5.0 * T, -25.0)
+    th[(T > 4.0) & (T < 4.2)] = -24.0  # a brief excursion out of the 0.5 deg band
+    assert M.time_to_reach(T, th, -25.0, 0.0, 20.0, 0.5, 0.5) == pytest.approx(2.9, abs=1e-9)
+    assert M.time_to_reach(T, th, -25.0, 0.0, 20.0, 0.5, 2.0) == pytest.approx(4.2, abs=1e-9)
+    assert M.time_to_reach(T, th, -25.0, 0.0, 20.0, 0.5, 30.0) is None
+
+
+def test_martensite_time():
+    xi = np.clip(0.2 + 0.1 * T, 0.0, 1.0)  # 1 at t = 8 s
+    assert M.martensite_time(T, xi, 2.0) == pytest.approx(5.99, abs=2e-3)
+    assert M.martensite_time(T, xi, 9.0) is None  # already martensite: nothing to wait for
+    assert M.martensite_time(T, np.full_like(T, 0.5), 0.0) is None
+
+
+def test_increase_of_a_cumulative_signal():
+    assert M.increase(T, 3.0 * T, 2.0, 5.0) == pytest.approx(9.0)
+
+
+# ---- open loop and the cooling phase ---------------------------------------------------------------
+def test_openloop_metrics_on_a_known_signal():
+    # rise 3 deg/s from t = 1 s to a 10 deg range at 4.33 s, held until the voltage goes off
+    # at 10 s, then back to 1 deg with a time constant of 1 s
+    up = np.clip(3.0 * (T - 1.0), 0.0, 10.0)
+    down = 1.0 + 9.0 * np.exp(-(T - 10.0))
+    th = -40.0 + np.where(T <= 10.0, up, down)
+    m = M.openloop_metrics(T, th, 10.0)
+    assert m["range_deg"] == pytest.approx(10.0)
+    assert m["start_s"] == pytest.approx(1.034)
+    assert m["rise90_s"] == pytest.approx(4.0, abs=1e-9)
+    assert m["still_moving_deg_s"] == 0.0
+    assert m["angle_at_off_deg"] == pytest.approx(-30.0)
+    assert m["final_deg"] == pytest.approx(-39.0, abs=1e-3)
+    # 0.1 deg back after ln(90 / 89.0) s; 90 % of the way after ln(10) s
+    assert m["return_start_s"] == pytest.approx(np.log(9.0 / 8.9), abs=1e-3)
+    assert m["return90_s"] == pytest.approx(np.log(10.0), abs=2e-3)
+    flat = M.openloop_metrics(T, np.full_like(T, -40.0), 10.0)
+    assert flat["range_deg"] == 0.0 and flat["start_s"] is None and flat["return90_s"] is None
+
+
+def test_cooling_phase_metrics_on_a_known_signal():
+    t = np.arange(0.0, 10.0, 0.01)
+    theta = np.where(t < 2.0, -40.0 + 5.0 * t, -30.0 + 0.2 * np.sin(np.pi * (t - 2.0) / 3.0))
+    T_C = 90.0 - 2.0 * t
+    m = M.cooling_phase_metrics(t, theta, T_C, -30.0)
+    assert m["cooling_start_s"] == pytest.approx(2.01)
+    assert m["cooling_s"] == pytest.approx(3.0, abs=0.011)
+    assert m["cooling_rate_C_s"] == pytest.approx(2.0)
+    assert m["peak_past_deg"] == pytest.approx(0.2, abs=1e-3)
+    assert m["overshoot_after_deg"] == pytest.approx(0.2, abs=1e-3)
+    flat = M.cooling_phase_metrics(t, np.full_like(t, -35.0), T_C, -30.0)
+    assert flat["cooling_s"] is None and flat["peak_past_deg"] == 0.0
+
+
+# ---- cycles ---------------------------------------------------------------------------------
+def _segments(reached, hold_s=0.5):
+    out, start = [], 0.0
+    for i, r in enumerate(reached):
+        out.append({"index": i, "start_s": start, "reached_s": r})
+        if r is None:
+            break
+        start += r + hold_s
+    return out
+
+
+@settings(max_examples=50)
+@given(st.lists(st.floats(0.1, 20.0), min_size=1, max_size=5), st.floats(0.0, 3.0))
+def test_cycle_time_on_reach_is_the_sum_of_reached_s(reached, hold_s):
+    segs = _segments(reached, hold_s)
+    cyc = M.cycle_time(segs, n_on_reach=len(segs) - 1, hold_s=hold_s)
+    assert cyc == pytest.approx(M.reached_sum(segs), abs=1e-9)
+    assert M.elapsed_time(segs) == pytest.approx(cyc + (len(segs) - 1) * hold_s, abs=1e-9)
+
+
+def test_a_cycle_that_does_not_finish_has_no_time():
+    segs = _segments([5.0, None])
+    assert M.elapsed_time(segs) is None and M.cycle_time(segs, 1, 0.5) is None
+    assert M.reached_sum(segs) is None
+
+
+def test_reduction():
+    assert M.reduction(37.5, 27.5) == pytest.approx(10.0 / 37.5)
+    assert M.reduction(None, 27.5) is None
