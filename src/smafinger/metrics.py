@@ -22,7 +22,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 
-from .engine.run import TICK_S
+from .engine.clock import TICK_S
 
 #: a sample belongs to a window if within this of its edges (half a clock tick) [s]
 EDGE_S = 0.5 * TICK_S

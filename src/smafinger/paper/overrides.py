@@ -20,8 +20,9 @@ import typing
 from dataclasses import dataclass
 from typing import Any, Iterable
 
-from ..parameters import ParameterError, ParameterSet
+from ..parameters import MECHANISMS, ParameterError, ParameterSet
 from ..parameters.base import parse_value
+from ..parameters.options import OPTION_NAMES, OPTION_TYPES, parse_option
 
 #: run settings an override may change (``make_spec`` arguments), with their types
 RUN_SETTINGS: dict[str, type] = {
@@ -31,8 +32,12 @@ RUN_SETTINGS: dict[str, type] = {
 
 
 def _field_types() -> dict[str, type]:
-    hints = typing.get_type_hints(ParameterSet)
-    return {f.name: hints[f.name] for f in dataclasses.fields(ParameterSet)}
+    """Every mechanism's parameter fields with their types (options are checked by their enum)."""
+    out: dict[str, type] = {}
+    for cls in MECHANISMS.values():
+        hints = typing.get_type_hints(cls)
+        out.update({f.name: hints[f.name] for f in dataclasses.fields(cls) if f.name != "options"})
+    return out
 
 
 _FIELD_TYPES = _field_types()
@@ -79,6 +84,10 @@ class Overrides:
         for name, value in changes.items():
             if name in RUN_SETTINGS:
                 run[name] = _check(name, value, RUN_SETTINGS[name])
+            elif name in OPTION_TYPES:
+                params[name] = parse_option(name, value)
+            elif name in OPTION_NAMES:  # a boolean option
+                params[name] = _check(name, value, bool)
             elif name in _FIELD_TYPES:
                 params[name] = _check(name, value, _FIELD_TYPES[name])
             else:

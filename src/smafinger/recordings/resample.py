@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.run import TICK_S
+from ..engine.clock import TICK_S
 from .recording import Recording
 from .signals import RecordingError
 
