@@ -9,7 +9,7 @@ from smafinger import SimulationError, simulate
 from smafinger.engine import integrators
 from smafinger.engine.kernel import run_kernel
 from smafinger.engine.run import kernel_args, make_spec
-from smafinger.engine.signals import new_outputs
+from smafinger.engine.signals import kernel_views, new_outputs
 from smafinger.model.build import build_model
 from smafinger.model.kinetics import g_heating
 from smafinger.parameters import get
@@ -88,7 +88,7 @@ def test_interlock_counter_counts_a_forced_violation():
     prog = args["prog"]
     forced = prog._replace(level=np.array([[8.0, 8.0]]), duty=np.array([[100.0, 100.0]]))  # bypasses the check
     run = args["run"]
-    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, 2)
+    mech, wires = kernel_views(*new_outputs(run.t_end_ticks // run.out_ticks + 1, 2))
     counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
                                 np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
     assert counters.violations == 100

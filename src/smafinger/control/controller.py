@@ -25,8 +25,8 @@ def pid_commands(model, enabled, q_target, state, level):
     u = pid_output(e, -state.v, state.error_integral, c.K_P, c.K_V, c.K_I)
     keep_on = model.options.controller_in_cooling
     w = model.wires
-    cmds = filled(w, wire_command(u, is_enabled(enabled, 0), w[0].direction, q_target, state.q, keep_on, level))
-    for i in range(1, len(w)):
+    cmds = filled(w, Command(False, False, 0.0, level))
+    for i in range(len(w)):
         cmds = set_item(cmds, i, wire_command(u, is_enabled(enabled, i), w[i].direction, q_target, state.q,
                                               keep_on, level))
     frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)

@@ -14,7 +14,7 @@ from numba import njit
 
 from ..model.records import State, WireState
 from .rhs import derivative, geometry_at
-from .tuples import filled, set_item
+from .tuples import set_item
 
 
 class Method(IntEnum):
@@ -50,8 +50,8 @@ def _wire_axpy(a, c, b):
 @njit(cache=True, inline="always")
 def axpy(y, c, k):
     """y + c k, field by field."""
-    ws = filled(y.wires, _wire_axpy(y.wires[0], c, k.wires[0]))
-    for i in range(1, len(y.wires)):
+    ws = y.wires
+    for i in range(len(ws)):
         ws = set_item(ws, i, _wire_axpy(y.wires[i], c, k.wires[i]))
     return State(y.q + c * k.q, y.v + c * k.v, y.error_integral + c * k.error_integral, ws)
 

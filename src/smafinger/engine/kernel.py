@@ -22,7 +22,8 @@ from ..control.strategies import Strategy
 from ..parameters.options import IntegralReset
 from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, track_reach
-from .substep import Counters, initial_commands, initial_inputs, initial_state, substep
+from .signals import record_sample
+from .substep import Counters, decide, initial_commands, initial_inputs, initial_state, integrate
 from .tuples import with_field
 
 
@@ -52,7 +53,7 @@ class Program(NamedTuple):
 
 
 @njit(cache=True, inline="always")
-def _interval_end(t, run, s, segs, prog, prog_i, cmds):
+def _interval_end(t, run, cmds, next_event):
     """End of the interval that starts at tick t: the next step, PWM period, sample, update or event."""
     ps = (t // run.pwm_ticks) * run.pwm_ticks
     t_next = min(((t // run.dt_ticks) + 1) * run.dt_ticks, run.t_end_ticks)
@@ -62,10 +63,8 @@ def _interval_end(t, run, s, segs, prog, prog_i, cmds):
     t_next = min(t_next, ((t // run.out_ticks) + 1) * run.out_ticks)
     if run.update_ticks > 0:
         t_next = min(t_next, ((t // run.update_ticks) + 1) * run.update_ticks)
-    if s.next_seg < len(segs.start) and segs.start[s.next_seg] > t:
-        t_next = min(t_next, segs.start[s.next_seg])
-    if run.strategy == Strategy.OPEN_LOOP and prog_i < len(prog.ticks):
-        t_next = min(t_next, prog.ticks[prog_i])
+    if next_event > t:
+        t_next = min(t_next, next_event)
     return t_next
 
 
@@ -91,27 +90,35 @@ def _sub_bounds(t, t_next, ps, cmds, pwm_ticks, bounds):
 
 
 @njit(cache=True, inline="always")
-def _control(t, started, run, model, s, y, cmds, integrating, prog, prog_i):
-    """The control tick at t: (commands, integrating, program index)."""
-    if run.strategy == Strategy.OPEN_LOOP:
-        while prog_i < len(prog.ticks) and prog.ticks[prog_i] <= t:
-            prog_i += 1
-        if prog_i > 0:
-            cmds = program_commands(cmds, prog.level[prog_i - 1], prog.duty[prog_i - 1])
-        return cmds, integrating, prog_i
-    if started or run.update_ticks == 0 or t % run.update_ticks == 0:
-        cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
-    return cmds, integrating, prog_i
+def _segment_due(s, t, seg_start):
+    """A segment starts at t (its time has come, or its predecessor's target was reached)."""
+    if s.next_seg >= len(seg_start):
+        return False
+    st = seg_start[s.next_seg]
+    return (st >= 0 and st <= t) or (st < 0 and s.confirmed)
+
+
+@njit(cache=True)
+def _next_event(s, run, segs, prog, prog_i):
+    """The next scheduled change after now: a segment start or a program step (-1: none)."""
+    e = -1
+    if s.next_seg < len(segs.start) and segs.start[s.next_seg] >= 0:
+        e = segs.start[s.next_seg]
+    if run.strategy == Strategy.OPEN_LOOP and prog_i < len(prog.ticks):
+        e = prog.ticks[prog_i] if e < 0 else min(e, prog.ticks[prog_i])
+    return e
 
 
 @njit(cache=True, nogil=True)
 def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reached):
     """Simulate from t = 0 to t_end; fill the output arrays (one row per output sample).
 
-    ``seg_reached[k]`` becomes the tick at which segment k's target was entered for good (within
-    ``run.tol`` for ``run.hold_ticks``), -1 if never. Returns (counters, state, t_fail_s): if
-    the state became NaN or Inf, ``counters.status`` is 1 and ``state`` is the state at
-    ``t_fail_s``.
+    ``mech_out`` (samples x mechanism fields) and ``wire_out`` (samples x wires x wire fields) are
+    written by column (``signals.MC``, ``signals.WC``). ``seg_reached[k]`` becomes the tick at
+    which segment k's target was entered for good (within ``run.tol`` for ``run.hold_ticks``), -1 if
+    never. Returns (counters, state, t_fail_s): if the state became NaN or Inf, ``counters.status``
+    is 1 and ``state`` is the state at ``t_fail_s``. No array is passed to a helper on the
+    per-sub-step path (each pass costs atomic reference counting).
     """
     y = initial_state(model)
     inputs = initial_inputs(model, run.current_drive)
@@ -121,37 +128,54 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     geom_q = y.q
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
+    n_out = mech_out.shape[0]
     integrating = 1.0
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
+    next_event = _next_event(s, run, segs, prog, prog_i)
     while True:
-        geom = geometry_at(y.q, geom_q, geom, model)
-        geom_q = y.q
-        s, started = advance(s, t, segs, seg_actual, run.strategy, run.wait_release, model, y, inputs, geom)
+        if _segment_due(s, t, segs.start) or s.waiting:
+            geom = geometry_at(y.q, geom_q, geom, model)
+            geom_q = y.q
+            s, started = advance(s, t, segs, seg_actual, run.strategy, run.wait_release, model, y, inputs, geom)
+            next_event = _next_event(s, run, segs, prog, prog_i)
+        else:
+            started = False
         if started and model.options.integral_reset == IntegralReset.SEGMENT:
             y = with_field(y, "error_integral", 0.0)
-        cmds, integrating, prog_i = _control(t, started, run, model, s, y, cmds, integrating, prog, prog_i)
+        if run.strategy == Strategy.OPEN_LOOP:
+            if prog_i < len(prog.ticks) and prog.ticks[prog_i] <= t:
+                while prog_i < len(prog.ticks) and prog.ticks[prog_i] <= t:
+                    prog_i += 1
+                cmds = program_commands(cmds, prog.level[prog_i - 1], prog.duty[prog_i - 1])
+                next_event = _next_event(s, run, segs, prog, prog_i)
+        elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
+            cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
-        t_next = _interval_end(t, run, s, segs, prog, prog_i, cmds)
+        t_next = _interval_end(t, run, cmds, next_event)
         ps = (t // run.pwm_ticks) * run.pwm_ticks
         a = float(t)
         for j in range(_sub_bounds(t, t_next, ps, cmds, run.pwm_ticks, bounds)):
             b = bounds[j]
-            record = j == 0 and t == next_out and out_i < len(mech_out.t)
-            y, inputs, geom, geom_q, stuck, v_prev, counters, t_fail = substep(
+            y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives = decide(
                 model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck,
-                v_prev, counters, record, out_i, mech_out, wire_out)
+                v_prev, counters)
             first = False
-            if record:
+            if j == 0 and t == next_out and out_i < n_out:
+                record_sample(mech_out, wire_out, out_i, a * run.tick_s, y, aux, s.q_target, s.next_seg - 1,
+                              stuck, cmds, drives)
                 out_i += 1
                 next_out += run.out_ticks
+            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b
         if t >= run.t_end_ticks:
             break
         t = t_next
-        s = track_reach(s, t, y.q, run.tol, run.hold_ticks, seg_reached)
-        if t >= run.t_end_ticks and not (t == next_out and out_i < len(mech_out.t)):
+        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks)
+        if reached >= 0:
+            seg_reached[s.next_seg - 1] = reached
+        if t >= run.t_end_ticks and not (t == next_out and out_i < n_out):
             break  # else: one more pass records the final sample
     return counters, y, 0.0

@@ -32,8 +32,8 @@ class Geometry(NamedTuple):
 def geometry(model, q):
     """:class:`Geometry` at coordinate q (Eqs. 3-6 and the external load of Eq. 1b)."""
     w = model.wires
-    routes = filled(w, route(w[0].route, q))
-    for i in range(1, len(w)):
+    routes = filled(w, (0.0, 0.0, 0.0))
+    for i in range(len(w)):
         routes = set_item(routes, i, route(w[i].route, q))
     c = math.cos(q)
     return Geometry(routes, c, external_load(model.dynamics.load, q, c))
@@ -62,10 +62,10 @@ def _wire_terms(model, state, inputs, geom, i):
 @njit(cache=True, inline="always")
 def derivative(state, inputs, model, geom):
     """(dstate/dt, aux): the derivative of the state and the algebraic quantities (loads, xi, sigma)."""
-    rate0, aux0, load = _wire_terms(model, state, inputs, geom, 0)
-    rates = filled(state.wires, rate0)
-    auxs = filled(state.wires, aux0)
-    for i in range(1, len(state.wires)):
+    rates = filled(state.wires, WireState(0.0, 0.0, 0.0))
+    auxs = filled(state.wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    load = 0.0
+    for i in range(len(state.wires)):  # one copy of the wire physics, whatever the wire count
         r, a, l_i = _wire_terms(model, state, inputs, geom, i)
         rates = set_item(rates, i, r)
         auxs = set_item(auxs, i, a)

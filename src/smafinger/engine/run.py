@@ -19,7 +19,7 @@ from . import integrators
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
-from .signals import as_structured, new_outputs
+from .signals import kernel_views, new_outputs
 
 DEFAULT_DT_S = 1e-3
 #: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
@@ -151,14 +151,32 @@ def kernel_args(spec: RunSpec) -> dict:
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
-def _compiled_for(args: dict) -> bool:
-    """Is the kernel already compiled (or loaded from the cache) for these record types?"""
-    want = tuple(typeof(args[k]) for k in ("model", "run", "segs", "prog"))
-    return any(tuple(sig[:4]) == want for sig in run_kernel.signatures)
+class _CompiledKernels:
+    """The kernel compiled (or loaded from numba's cache) once per mechanism, then called directly.
+
+    numba types every argument at every call, and typing the nested records costs about a
+    millisecond; their types depend only on the mechanism (every value is a float, every option
+    an enum member), so the entry point is looked up once per mechanism and wire count.
+    """
+
+    def __init__(self) -> None:
+        self._entry: dict[tuple[str, int], object] = {}
+
+    def __call__(self, key: tuple[str, int], args: tuple):
+        fn = self._entry.get(key)
+        if fn is None:
+            sig = tuple(typeof(a) for a in args)
+            run_kernel.compile(sig)
+            fn = self._entry[key] = run_kernel.overloads[sig].entry_point
+        return fn
 
 
-def _call(args: dict, mech, wires, seg_actual, seg_reached):
-    return run_kernel(args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached)
+_kernels = _CompiledKernels()
+
+
+def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
+    mo, wo = kernel_views(mech, wires)
+    return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
 
 
 def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
@@ -170,20 +188,16 @@ def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
     n_seg = len(spec.profile.segments)
     seg_actual = np.full(n_seg, -1, dtype=np.int64)
     seg_reached = np.full(n_seg, -1, dtype=np.int64)
-    if not _compiled_for(args):
-        # compile (or load from the cache) on a one-step run, so wall_s times the loop alone
-        warm = dict(args, run=run._replace(t_end_ticks=run.dt_ticks, out_ticks=run.dt_ticks))
-        _call(warm, *new_outputs(2, n_wires), seg_actual.copy(), seg_reached.copy())
+    call_args = _kernel_args_tuple(args, mech, wires, seg_actual, seg_reached)
+    kernel = _kernels((spec.params.mechanism, n_wires), call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress:
-        counters, state, t_fail = _run_with_progress(lambda: _call(args, mech, wires, seg_actual, seg_reached),
-                                                     mech, spec.t_end_s)
+        counters, state, t_fail = _run_with_progress(lambda: kernel(*call_args), mech, spec.t_end_s)
     else:
-        counters, state, t_fail = _call(args, mech, wires, seg_actual, seg_reached)
+        counters, state, t_fail = kernel(*call_args)
     wall = time.perf_counter() - t0
     if counters.status != 0:
         raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
-    mech, wires = as_structured(mech, wires)
     return SimulationResult(
         spec=spec, mechanism=mech, wires=wires, segment_start_s=seg_actual * TICK_S,
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
@@ -214,7 +228,7 @@ def _run_with_progress(call, mech, t_end_s):
         th.start()
         while th.is_alive():
             th.join(0.1)
-            done = mech.t
+            done = mech["t"]
             filled = done[~np.isnan(done)]
             bar.update(task, completed=float(filled[-1]) if filled.size else 0.0)
     return box[0]

@@ -57,7 +57,7 @@ def _independent(s, target, model, state, inputs, geom, wait_release):
                     -1, False)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs, geom):
     """Start every segment due at tick t; end an independent strategy's wait if it is over.
 
@@ -89,14 +89,19 @@ def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs
 
 
 @njit(cache=True, inline="always")
-def track_reach(s, t, q, tol, hold_ticks, seg_reached):
-    """Record when the current target was entered for good (within ``tol`` for ``hold_ticks``)."""
+def track_reach(s, t, q, tol, hold_ticks):
+    """Track whether the current target has been entered for good (within ``tol`` for ``hold_ticks``).
+
+    Returns (schedule, reached): ``reached`` is the tick at which the target of segment
+    ``next_seg - 1`` was entered, on the tick this is confirmed; -1 otherwise.
+    """
     if abs(q - s.q_target) <= tol:
         band = t if s.band_since < 0 else s.band_since
+        reached = -1
         confirmed = s.confirmed
         if t - band >= hold_ticks and not confirmed:
             confirmed = True
             if s.next_seg >= 1:
-                seg_reached[s.next_seg - 1] = band
-        return with_field(with_field(s, "band_since", band), "confirmed", confirmed)
-    return with_field(s, "band_since", -1)
+                reached = band
+        return with_field(with_field(s, "band_since", band), "confirmed", confirmed), reached
+    return with_field(s, "band_since", -1), -1

@@ -1,9 +1,8 @@
 """The output signals, declared once: recorded field, SI unit, exported name and scale.
 
-The engine records, per run, one array per signal: :class:`MechanismOutputs` (one value per
-output sample) and :class:`WireOutputs` (one row per sample, one column per wire), both
-NamedTuples made from :data:`SIGNALS`; a result keeps them as two structured arrays
-(:data:`MECHANISM_DTYPE`, :data:`WIRE_DTYPE`). A result exports them as columns named here: ``{wire}`` becomes the
+A run's outputs are two structured arrays made from :data:`SIGNALS`: one row per output sample
+for the mechanism (:data:`MECHANISM_DTYPE`) and one per sample and wire (:data:`WIRE_DTYPE`).
+The engine writes them through float64 views, column by column (:data:`MC`, :data:`WC`). A result exports them as columns named here: ``{wire}`` becomes the
 wire's name (``upper``, ``lower``; ``wire`` for the linear actuator) and ``{q}``, ``{q_ref}``,
 ``{v}``, ``{load}`` the mechanism's names (``theta_deg``, ``theta_ref_deg``, ``omega_deg_s``,
 ``load_Nm`` for the joint; ``position_m``, ``position_ref_m``, ``velocity_m_s``, ``load_N`` for
@@ -57,10 +56,13 @@ WIRE_FIELDS = tuple(s.field for s in SIGNALS if s.per_wire)
 MECHANISM_DTYPE = np.dtype([(f, np.float64) for f in MECHANISM_FIELDS])
 WIRE_DTYPE = np.dtype([(f, np.float64) for f in WIRE_FIELDS])
 
-#: what the engine writes: one float64 array per signal (wires: samples x wires)
-MechanismOutputs = NamedTuple("MechanismOutputs", [(f, np.ndarray) for f in MECHANISM_FIELDS])
-WireOutputs = NamedTuple("WireOutputs", [(f, np.ndarray) for f in WIRE_FIELDS])
-MechanismOutputs.__module__ = WireOutputs.__module__ = __name__
+#: the column of each signal in the arrays the engine writes (samples x fields, and samples x
+#: wires x fields: float64 views of the structured arrays, no copy); compile-time constants
+MechanismColumns = NamedTuple("MechanismColumns", [(f, int) for f in MECHANISM_FIELDS])
+WireColumns = NamedTuple("WireColumns", [(f, int) for f in WIRE_FIELDS])
+MechanismColumns.__module__ = WireColumns.__module__ = __name__
+MC = MechanismColumns(*range(len(MECHANISM_FIELDS)))
+WC = WireColumns(*range(len(WIRE_FIELDS)))
 
 #: mechanism label -> names of {q}, {q_ref}, {v}, {load}
 COORDINATE_NAMES = {
@@ -84,44 +86,45 @@ def columns(mechanism: str, wire_names: tuple[str, ...], q_scale: float) -> list
     return out
 
 
-def new_outputs(n_samples: int, n_wires: int) -> tuple[MechanismOutputs, WireOutputs]:
-    """Empty (NaN) output arrays for a run."""
-    return (MechanismOutputs(*(np.full(n_samples, np.nan) for _ in MECHANISM_FIELDS)),
-            WireOutputs(*(np.full((n_samples, n_wires), np.nan) for _ in WIRE_FIELDS)))
+def new_outputs(n_samples: int, n_wires: int) -> tuple[np.ndarray, np.ndarray]:
+    """Empty (NaN) output arrays for a run: (mechanism, wires), structured."""
+    mech = np.empty(n_samples, dtype=MECHANISM_DTYPE)
+    wires = np.empty((n_samples, n_wires), dtype=WIRE_DTYPE)
+    mech.view(np.float64)[:] = np.nan  # every field is float64
+    wires.view(np.float64)[:] = np.nan
+    return mech, wires
 
 
-def as_structured(mech: MechanismOutputs, wires: WireOutputs) -> tuple[np.ndarray, np.ndarray]:
-    """The recorded arrays as two structured arrays (what a result keeps)."""
-    m = np.empty(len(mech.t), dtype=MECHANISM_DTYPE)
-    for f in MECHANISM_FIELDS:
-        m[f] = getattr(mech, f)
-    w = np.empty(wires.T.shape, dtype=WIRE_DTYPE)
-    for f in WIRE_FIELDS:
-        w[f] = getattr(wires, f)
-    return m, w
+def kernel_views(mech: np.ndarray, wires: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The float64 arrays the engine writes into: (samples x fields), (samples x wires x fields).
+
+    Views of the structured arrays (every field is float64), so nothing is copied either way.
+    """
+    return (mech.view(np.float64).reshape(len(mech), len(MECHANISM_FIELDS)),
+            wires.view(np.float64).reshape(wires.shape[0], wires.shape[1], len(WIRE_FIELDS)))
 
 
 @njit(cache=True, inline="always")
 def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives):
-    """Write output sample ``i``: every signal (a test checks none is left NaN)."""
-    mo.t[i] = t_s
-    mo.q[i] = state.q
-    mo.q_ref[i] = q_target
-    mo.v[i] = state.v
-    mo.load[i] = aux.load
-    mo.stuck[i] = 1.0 if stuck else 0.0
-    mo.segment[i] = segment
+    """Write output sample ``i``: every signal, by its column (a test checks none is left NaN)."""
+    mo[i, MC.t] = t_s
+    mo[i, MC.q] = state.q
+    mo[i, MC.q_ref] = q_target
+    mo[i, MC.v] = state.v
+    mo[i, MC.load] = aux.load
+    mo[i, MC.stuck] = 1.0 if stuck else 0.0
+    mo[i, MC.segment] = segment
     for w in range(len(state.wires)):
         ws = state.wires[w]
         wa = aux.wires[w]
-        wo.T[i, w] = ws.T_C
-        wo.xi[i, w] = wa.xi
-        wo.sigma[i, w] = wa.sigma_Pa
-        wo.force[i, w] = wa.force_N
-        wo.arm[i, w] = wa.arm_m
-        wo.spring[i, w] = wa.spring_m
-        wo.V[i, w] = drives[w]
-        wo.duty[i, w] = cmds[w].duty
-        wo.energy[i, w] = ws.electrical_J
-        wo.enabled[i, w] = 1.0 if cmds[w].enabled else 0.0
-        wo.heating[i, w] = 1.0 if cmds[w].heating else 0.0
+        wo[i, w, WC.T] = ws.T_C
+        wo[i, w, WC.xi] = wa.xi
+        wo[i, w, WC.sigma] = wa.sigma_Pa
+        wo[i, w, WC.force] = wa.force_N
+        wo[i, w, WC.arm] = wa.arm_m
+        wo[i, w, WC.spring] = wa.spring_m
+        wo[i, w, WC.V] = drives[w]
+        wo[i, w, WC.duty] = cmds[w].duty
+        wo[i, w, WC.energy] = ws.electrical_J
+        wo[i, w, WC.enabled] = 1.0 if cmds[w].enabled else 0.0
+        wo[i, w, WC.heating] = 1.0 if cmds[w].heating else 0.0

@@ -20,7 +20,6 @@ from ..model.wire import wire_stress_xi
 from ..parameters.options import FrictionSticking, StressLaw
 from .integrators import step
 from .rhs import derivative, geometry_at
-from .signals import record_sample
 from .tuples import filled, set_item, with_field
 
 
@@ -106,11 +105,12 @@ def _finite(y):
 
 
 @njit(cache=True, inline="always")
-def substep(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck, v_prev,
-            counters, record, out_i, mech_out, wire_out):
-    """Decide, record (if ``record``) and integrate the sub-step [a, b] (ticks).
+def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck, v_prev,
+           counters):
+    """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, branches,
+    stick/slip (Eq. 2), and the derivative there.
 
-    Returns (y, inputs, geom, geom_q, stuck, v_prev, counters, t_fail_s).
+    Returns (y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives).
     """
     geom = geometry_at(y.q, geom_q, geom, model)
     geom_q = y.q
@@ -135,16 +135,19 @@ def substep(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, 
             counters = with_field(counters, "sticks", counters.sticks + 1)
         stuck = new_stuck
         inputs = with_field(inputs, "stuck", stuck)
-    v_prev = y.v
-    if record:
-        record_sample(mech_out, wire_out, out_i, a * run.tick_s, y, aux, s.q_target, s.next_seg - 1, stuck,
-                      cmds, drives)
+    return y, inputs, geom, geom_q, stuck, y.v, with_field(counters, "evals", evals), k1, aux, drives
+
+
+@njit(cache=True, inline="always")
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters):
+    """Advance the state over [a, b] (ticks) and apply the post-step constraints.
+
+    Returns (y, counters, t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
+    """
     if b > a:
         y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom)
-        evals += n
-        counters = with_field(counters, "substeps", counters.substeps + 1)
-    counters = with_field(counters, "evals", evals)
+        counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
-        return y, inputs, geom, geom_q, stuck, v_prev, with_field(counters, "status", 1), b * run.tick_s
-    return y, inputs, geom, geom_q, stuck, v_prev, counters, 0.0
+        return y, with_field(counters, "status", 1), b * run.tick_s
+    return y, counters, 0.0

@@ -1,16 +1,36 @@
-"""Per-wire tuples in compiled code: numba has no map over a tuple, so these two do it.
+"""Per-wire tuples in compiled code: numba has no map over a tuple, so these helpers do it.
 
 A run's wires are a homogeneous tuple (one record type), so numba indexes it at run time and
-knows its length at compile time. ``out = filled(wires, f(wires[0]))`` makes a tuple of the
-right length; ``out = set_item(out, i, f(wires[i]))`` replaces an item (a new tuple, by value).
+knows its length at compile time. ``out = filled(wires, ZERO)`` makes a tuple of the right
+length; ``out = set_item(out, i, f(wires[i]))`` replaces an item (a new tuple, by value).
+
+``set_item`` is generated for the tuple's length as a chain of ``if i == k`` rebuilding the
+tuple: numba's own ``tuple_setitem`` stores through a stack slot at a run-time index, which LLVM
+cannot keep in registers, and that slowed the engine two-fold.
 """
 
 from numba import types
-from numba.cpython.unsafe.tuple import tuple_setitem
 from numba.extending import overload
 
-#: a copy of a homogeneous tuple with item i replaced (numba's tuple_setitem)
-set_item = tuple_setitem
+
+def set_item(tup, i, value):
+    """A copy of the homogeneous tuple ``tup`` with item ``i`` replaced (compiled code only)."""
+    raise NotImplementedError("set_item() is compiled code: call it from a numba function")
+
+
+@overload(set_item)
+def _set_item(tup, i, value):
+    if not isinstance(tup, types.BaseTuple):
+        return None
+    n = len(tup)
+    lines = ["def impl(tup, i, value):"]
+    for k in range(n):
+        items = ", ".join("value" if j == k else f"tup[{j}]" for j in range(n))
+        lines.append(f"    {'if' if k == 0 else 'elif'} i == {k}:\n        return ({items},)")
+    lines.append("    return tup")
+    ns: dict = {}
+    exec("\n".join(lines) + "\n", ns)
+    return ns["impl"]
 
 
 def filled(template, value):

@@ -17,13 +17,13 @@ import math
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def youngs_modulus(xi, D_A, D_M):
     """D = D_A + xi (D_M - D_A) (Eq. 7a)."""
     return D_A + xi * (D_M - D_A)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def spring_stiffness(x, K_S, x_limit, fact):
     """K_s,eff [N/m] at spring elongation x [m]; stiffening beyond x_limit (dx in mm)."""
     dx_mm = 1000.0 * (x - x_limit)
@@ -62,14 +62,14 @@ def spring_elongation(F, K_S, x_limit, fact):
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def equivalent_modulus(K_s, D, S_w, L_w):
     """D_eq = K_eq L_w / S_w with K_eq = K_s K_D / (K_s + K_D) (Eq. 8) [Pa]."""
     K_D = D * S_w / L_w
     return K_s * K_D / (K_s + K_D) * L_w / S_w
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def stress_rate(D_eq, deps_dt, eps_R, dxi_dT, dxi_dsigma, dT_dt, sigma):
     """dsigma/dt of Eq. (7b), solved together with dxi/dt = xi_T T' + xi_sigma sigma'.
 

@@ -74,7 +74,7 @@ def wire_load(sigma, area, dpath_dq):
     return sigma * area * (-dpath_dq)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sliding_friction(omega, M_DF, C_DF):
     """M_Fr [N m] of Eq. (2) while sliding."""
     if omega > 0.0:
@@ -84,7 +84,7 @@ def sliding_friction(omega, M_DF, C_DF):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def angular_acceleration(M_E, omega, stuck, I, M_DF, C_DF):
     """q'' of Eq. (1a) (theta'' [rad/s^2] for the joint)."""
     if stuck:

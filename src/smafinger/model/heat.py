@@ -21,7 +21,7 @@ from numba import njit
 from ..parameters.options import JouleHeating
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def convection_coefficient(T, h0, h2):
     """h = h0 + h2 T^2 [W/(m^2 K)] (Eq. 11), T in degC as in the paper."""
     return h0 + h2 * T * T
@@ -45,7 +45,7 @@ def electrical_power(wire, drive, current_drive):
     return drive * drive / wire.resistance_ohm
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def heat_balance(T, P, h, T_amb, M_w, C_p, A_w):
     """dT/dt [degC/s] of Eq. (11) for power P' [W/m] and coefficient h."""
     return (P - h * A_w * (T - T_amb)) / (M_w * C_p)

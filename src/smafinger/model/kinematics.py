@@ -45,7 +45,7 @@ class DirectPull(NamedTuple):
     dpath_dq: float  #: -1: the path shortens as the slider moves in the pulling direction
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     """Path length [m], d(path)/d(theta) [m/rad] and moment arm b [m] of one tendon.
 

@@ -37,7 +37,7 @@ def initial_branch(xi_init: float, T_init_C: float) -> Branch:
     return Branch(HOLD, xi_init, xi_init, T_init_C)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def g_heating(T, sigma, A_S0, A_F0, c_A):
     """g_A and its partial derivatives (d/dT, d/dsigma) of Eq. (9)."""
     shift = sigma / c_A
@@ -54,7 +54,7 @@ def g_heating(T, sigma, A_S0, A_F0, c_A):
     return g, dg_dT, -dg_dT / c_A
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def g_cooling(T, sigma, M_S0, M_F0, c_M):
     """g_M and its partial derivatives (d/dT, d/dsigma) of Eq. (10)."""
     shift = sigma / c_M
@@ -71,7 +71,7 @@ def g_cooling(T, sigma, M_S0, M_F0, c_M):
     return g, dg_dT, -dg_dT / c_M
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def martensite_fraction(branch, start, xi_held, T, sigma, A_S0, A_F0, c_A, M_S0, M_F0, c_M):
     """xi and its partials (dxi/dT, dxi/dsigma) on a branch (Eqs. 9b, 10b).
 

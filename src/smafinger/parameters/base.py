@@ -94,6 +94,8 @@ class ParameterSet:
         for f in fields(self):
             if f.name != "options":
                 _check_field(f, getattr(self, f.name))
+                if f.metadata["kind"] == "float":  # an int from a file is stored as a float
+                    object.__setattr__(self, f.name, float(getattr(self, f.name)))
         self._cross_checks()
 
     def __getattr__(self, name: str) -> Any:
