@@ -105,6 +105,50 @@ RIPPLE_95 = (np.concatenate([np.linspace(23.0, 95.0, 200),
              np.zeros(4201))
 
 
+# ---- the numba operator, driven as the engine drives it, against the pure-Python reference --
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(material_and_history())
+def test_numba_operator_equals_the_reference(case):
+    m, T, sigma, xi0 = case
+    r = xi_history(T, sigma, m, xi_init=xi0)
+    ref = HysteresisOperator(m, xi0)
+    assert np.array_equal(r.xi, ref.run(T, sigma))  # the same operations: to the bit
+    assert r.clamps == ref.clamps
+
+
+@st.composite
+def unequal_c_stress_walks(draw):
+    """c_A != c_M with T and sigma both wandering: the two taus move apart and cross."""
+    m = draw(materials().filter(lambda m: m.c_A_Pa_per_C != m.c_M_Pa_per_C))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    s_max = stress_cap(m)
+    lo, hi = temperature_range(m, s_max)
+    n = draw(st.integers(10, 300))
+    dT = rng.normal(0.0, draw(st.sampled_from([0.3, 2.0])), n)
+    if draw(st.booleans()):  # stress steps independent of the temperature steps
+        ds = rng.normal(0.0, s_max / 20, n)
+    else:  # dsigma/dT between c_A and c_M, often: one tau rises while the other falls
+        c = rng.uniform(min(m.c_A_Pa_per_C, m.c_M_Pa_per_C), max(m.c_A_Pa_per_C, m.c_M_Pa_per_C), n)
+        ds = dT * c * rng.choice([1.0, 1.0, 0.5, -1.0], n)
+    T = np.clip(rng.uniform(lo, hi) + np.cumsum(dT), lo, hi)
+    sigma = np.clip(rng.uniform(0, s_max) + np.cumsum(ds), 0.0, s_max)
+    return m, T, sigma, start_inside(m, T[0], sigma[0], draw(st.sampled_from([0.0, 1.0, 0.37])))
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(unequal_c_stress_walks())
+def test_unequal_c_properties_and_reference(case):
+    m, T, sigma, xi0 = case
+    r = xi_history(T, sigma, m, xi_init=xi0)
+    ref = HysteresisOperator(m, xi0)
+    assert np.array_equal(r.xi, ref.run(T, sigma))
+    assert max(ref.pop_gaps, default=0.0) <= 1e-12
+    assert max(ref.flat_gaps, default=0.0) <= 1e-12
+    assert all(ref.passes[k] >= 2 for k in hc.jump_violations(r.xi, r.xi_step_end))
+    assert hc.direction_violations(T, sigma, r.xi, m).size == 0
+    assert hc.loop_violations(T, sigma, r.xi, m).size == 0
+
+
 # ---- property 1: continuous, in [0, 1] ------------------------------------------------------
 @SETTINGS
 @given(material_and_history())
@@ -147,6 +191,20 @@ def test_p2_moves_only_with_its_driving_tau_inside_its_band(case):
     m, T, sigma, xi0 = case
     r = xi_history(T, sigma, m, xi_init=xi0)
     assert hc.direction_violations(T, sigma, r.xi, m).size == 0
+
+
+def test_p2_holds_while_neither_transformation_is_driven():
+    """c_M > c_A: T up 1 degC while sigma rises 10 MPa, so tau_A falls and tau_M rises."""
+    m = kinetics_material(75.0, 110.0, 85.0, 60.0, 8e6, 15e6)
+    T, S = polyline((100.0, 0.0), (70.0, 0.0), (71.0, 10e6), (72.0, 20e6))
+    r = xi_history(T, S, m)
+    assert np.all(np.diff(r.xi[80:]) == 0.0) and hc.direction_violations(T, S, r.xi, m).size == 0
+    # and back on the cooling branch once tau_M falls past where it turned
+    T2, S2 = polyline((100.0, 0.0), (70.0, 0.0), (71.0, 10e6), (69.0, 10e6))
+    x = xi_history(T2, S2, m).xi
+    assert x[80] == r.xi[80] and x[-1] > x[80]
+    assert x[-1] == pytest.approx(xi_history(*polyline((100.0, 0.0), (70.0, 0.0), (70.0, 10e6),
+                                                       (69.0, 10e6)), m).xi[-1], abs=1e-12)
 
 
 def test_p2_catches_today_rules():
@@ -227,6 +285,16 @@ def test_p4_return_point_memory(case, data):
     # after the excursion the history continues as if it had not happened, to the bit
     assert np.array_equal(with_excursion[k + 1 + E.size:], base[k + 1:])
     assert np.array_equal(with_excursion[:k + 1], base[:k + 1])
+
+
+def test_p4_exact_when_the_excursion_starts_at_a_reversal():
+    """The base reverses at 82 degC (inside both bands); an excursion 82 -> 72 -> 82 inserted
+    there changes no bit of what follows."""
+    T, S = polyline((23.0, 0.0), (82.0, 0.0), (62.0, 0.0))
+    T2, S2 = polyline((23.0, 0.0), (82.0, 0.0), (72.0, 0.0), (82.0, 0.0), (62.0, 0.0))
+    a = xi_history(T, S, PAPER).xi
+    b = xi_history(T2, S2, PAPER).xi
+    assert np.array_equal(a[41:], b[121:]) and np.ptp(a[41:]) > 0.05
 
 
 def test_p4_catches_today_rules():
