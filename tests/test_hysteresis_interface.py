@@ -89,6 +89,37 @@ def test_stack_overflow_merges_the_innermost_loop():
     assert np.max(np.abs(small.xi[wiped:] - big.xi[wiped:])) <= 1e-12
 
 
+@st.composite
+def nested_paths(draw):
+    """Turning points that mostly nest (each inside the last loop), finely sampled."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    lo, hi = 50.0, 120.0
+    turns = [rng.uniform(lo, hi)]
+    for _ in range(draw(st.integers(5, 40))):
+        if rng.random() < 0.85:
+            lo, hi = (turns[-1], hi) if len(turns) % 2 else (lo, turns[-1])
+        turns.append(rng.uniform(lo, hi))
+    turns.append(draw(st.sampled_from([40.0, 130.0])))
+    T = np.concatenate([np.linspace(a, b, max(2, int(abs(b - a) / 0.02)), endpoint=False)
+                        for a, b in zip(turns[:-1], turns[1:])] + [turns[-1:]])
+    return T, draw(st.integers(4, 5))
+
+
+@settings(max_examples=250, deadline=None)
+@given(nested_paths())
+def test_merged_loops_keep_properties_1_to_3(case):
+    T, capacity = case
+    S = np.zeros(T.size)
+    xi0 = major_loop(T[0], 0.0, PAPER)[1]
+    r = xi_history(T, S, PAPER, xi_init=xi0, capacity=capacity)
+    L = math.pi / 2 / min(PAPER.A_F0_C - PAPER.A_S0_C, PAPER.M_S0_C - PAPER.M_F0_C)
+    # continuous: at 0.02 degC per sample no step of xi is steeper than a few major slopes
+    assert np.all(np.abs(np.diff(r.xi)) <= 4 * L * np.abs(np.diff(T)) + 1e-12)
+    assert hc.direction_violations(T, S, r.xi, PAPER).size == 0
+    assert hc.loop_violations(T, S, r.xi, PAPER).size == 0
+    assert r.depth.max() <= capacity
+
+
 def test_the_same_history_gives_the_same_bits():
     rng = np.random.default_rng(5)
     T = 85.0 + np.cumsum(rng.normal(0.0, 1.0, 500))
