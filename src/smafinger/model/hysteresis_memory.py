@@ -25,8 +25,10 @@ passes through it (:func:`_no_history`).
 
 Overflow (a reversal with a full stack) merges the innermost loop: the two rows under the
 new point are dropped and the new point's stored branch is re-aimed through it at row
-depth-4. Continuity, monotonicity and the major loop are kept; that loop's return point is
-lost (counted in ``merges``).
+depth-4. A branch between two points of equal g is flat, which needs their xi equal; the
+rules above guarantee it, a merge need not, so a row a new branch could not end at is
+dropped with its loop (``_unreachable``). Continuity, monotonicity and the major loop are
+kept; the merged loops' return points are lost (counted in ``merges``).
 """
 
 import math
@@ -130,14 +132,27 @@ def _write(stack, j, tauA, tauM, xi, gA, gM, x0, g0, slope):
     stack[j, S_SLOPE] = slope
 
 
+@njit(cache=True, inline="always")
+def _unreachable(stack, t, d, x, g):
+    """True if a branch in direction d through (g, x) cannot end at row t: the same g but
+    another xi (possible only after a merge; a loop the branch could not close)."""
+    return stack[t, _g_col(d)] == g and abs(stack[t, S_XI] - x) > LOOP_TOL
+
+
 @njit(cache=True)
 def _push(stack, depth, tauA, tauM, xi, gA, gM, d, x0, g0, slope):
-    """Push a reversal point; on a full stack merge the innermost loop. Returns (depth, merged)."""
+    """Push a reversal point; on a full stack merge the innermost loop. Returns (depth, merged).
+
+    Merge: the point takes the place of the two rows under it (more if its new branch could
+    not end at the row it would be aimed at), with a branch through it aimed at row j-2.
+    """
     if depth < stack.shape[0]:
         _write(stack, depth, tauA, tauM, xi, gA, gM, x0, g0, slope)
         return depth + 1, 0
     g = gA if d > 0 else gM
-    j = depth - 2  # the point replaces the innermost loop's two rows
+    j = depth - 2
+    while j >= 2 and _unreachable(stack, j - 2, d, xi, g):
+        j -= 2
     _write(stack, j, tauA, tauM, xi, gA, gM, xi, g, aim(stack, j, d, xi, g))
     return j + 1, 1
 
@@ -242,8 +257,10 @@ def memory_update(d, x0, g0, slope, lim_tau, lim_g, clamps, merges, stack, depth
         d = want
         lim_tau, lim_g = _own(d, tauA, tauM, gA, gM)
         # a target already reached here (c_A != c_M after a stress change, or a loop of zero
-        # width): it is dropped and the new branch keeps its anchor at the current point
-        while depth >= 2 and _reached(d, lim_tau, stack[depth - 2, _tau_col(d)]):
+        # width) or that this branch cannot end at (after a merge): its loop is dropped and
+        # the new branch keeps its anchor at the current point
+        while depth >= 2 and (_reached(d, lim_tau, stack[depth - 2, _tau_col(d)])
+                              or _unreachable(stack, depth - 2, d, xi, lim_g)):
             depth -= 2
         x0, g0 = xi, lim_g
         slope = aim(stack, depth, d, x0, g0)

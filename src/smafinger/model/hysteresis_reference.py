@@ -7,7 +7,8 @@ target is reached within an interval is wiped out at the interval's end, so ther
 within-step approximation. It records what the property tests need to see: the gap between
 the two branches at every wiped-out target (continuity) and the number of targets reached
 in each interval (``passes``), every flat branch built between two
-points of equal g with the difference of their xi, and every clamp to the major loop.
+points of equal g with the difference of their xi (``flat_gaps``; ``unreachable`` when that
+difference would make the branch skip its target), and every clamp to the major loop.
 """
 
 from dataclasses import dataclass, field
@@ -61,6 +62,7 @@ class HysteresisOperator:
     extreme: Point | None = None  # where the branch's own tau went furthest (xi holds behind)
     pop_gaps: list = field(default_factory=list)
     passes: list = field(default_factory=list)
+    unreachable: list = field(default_factory=list)
     flat_gaps: list = field(default_factory=list)
     clamps: int = 0
 
@@ -86,6 +88,14 @@ class HysteresisOperator:
             self.flat_gaps.append(abs(x_r - x_t))
             return 0.0
         return max((x_r - x_t) / (g_r - g_t), 0.0)
+
+    def _unreachable(self, target, direction, xi, g):
+        """Same g, other xi: a branch from here could not end there (logged: the rules
+        guarantee it never happens without a merge, and the reference has no merges)."""
+        if target.g(direction) == g and abs(target.xi - xi) > LOOP_TOL:
+            self.unreachable.append(abs(target.xi - xi))
+            return True
+        return False
 
     @staticmethod
     def _reached(direction, tau, target_tau):
@@ -178,8 +188,9 @@ class HysteresisOperator:
             else:
                 point = Point(here.tau_A, e.tau_M, xi, here.g_A, e.g_M, self.branch)
             self.points.append(point)
-            while len(self.points) >= 2 and self._reached(direction, here.tau(direction),
-                                                          self.points[-2].tau(direction)):
+            while len(self.points) >= 2 and (
+                    self._reached(direction, here.tau(direction), self.points[-2].tau(direction))
+                    or self._unreachable(self.points[-2], direction, xi, here.g(direction))):
                 del self.points[-2:]
             self.branch = self._toward(direction, xi, here.g(direction))
             self.extreme = here
