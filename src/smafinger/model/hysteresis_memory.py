@@ -223,7 +223,6 @@ def memory_update(d, x0, g0, slope, lim_tau, lim_g, clamps, merges, stack, depth
     gM = g_cooling(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C)[0]
     tauA = T - sigma / m.c_A_Pa_per_C
     tauM = T - sigma / m.c_M_Pa_per_C
-    want = direction if direction != 0 else d
     if d == 0:
         if direction == 0:
             return d, x0, g0, slope, lim_tau, lim_g, clamps, merges, depth
@@ -246,6 +245,7 @@ def memory_update(d, x0, g0, slope, lim_tau, lim_g, clamps, merges, stack, depth
             d, x0, g0, slope, depth = _no_history(stack, xi, T, sigma, gA, gM, m)
             lim_tau, lim_g = _own(d, tauA, tauM, gA, gM)
         xi = _into_loop(xi, gA, gM)
+    want = direction if direction != 0 else d  # 0: keep the branch the wire is on now
     if want == -d:
         qA, qM, qgA, qgM = tauA, tauM, gA, gM
         if d > 0:
