@@ -71,8 +71,8 @@ class BranchRecord(NamedTuple):
     driven by tau_M), 0 hold (virgin state, or the legacy rules' hold): xi = ``x0``.
     On a branch xi = x0 + slope (g - g0). Memory rule: ``lim_tau`` is the extreme of the
     branch's own tau at the last update and ``lim_g`` g there; xi holds at its value there
-    while tau is back from it (neither transformation is driven). The branch ends at its target
-    (``target_tau`` in the branch's own tau, +-inf when the branch runs to the end of the
+    while tau is back from it (a hold, or a turn within a sub-step). The branch ends at its
+    target (``target_tau`` in the branch's own tau, +-inf when the branch runs to the end of the
     major curve); past it ``xi_on_branch`` continues on the parent branch (the branch that
     led to the target), so the evaluation stays continuous within a sub-step.
     ``turn_C`` and ``reversal_C`` belong to the dead-band rule; ``clamps`` counts committed
