@@ -65,7 +65,7 @@ def test_pwm_edges_resolved_whatever_the_step():
     energies = []
     for dt in (1e-3, 3e-4, 7e-5):
         r = simulate(p, "independent", "0:-38", t_end_s=0.05, dt_s=dt, output_interval_s=1e-3)
-        energies.append(r.energy_upper_J[-1])
+        energies.append(r.electrical_energy_upper_J[-1])
     # same duty sequence (updated on integer ticks) -> same on-time within the rounding of h
     assert max(energies) - min(energies) < 1e-3 * max(energies)
 

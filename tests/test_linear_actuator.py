@@ -41,7 +41,7 @@ def test_steady_state_temperature_at_constant_power(rig):
     exact = T_ss + (p.T_init_C - T_ss) * np.exp(-r.t / tau)
     assert np.max(np.abs(r.T_wire_C - exact)) < 1e-6
     # the energy at the terminals is V^2 / (R_w L_w) times the time
-    assert r.energy_wire_J[-1] == pytest.approx(V**2 / (p.resistance_ohm_per_m * p.wire_length_m) * r.t[-1],
+    assert r.electrical_energy_wire_J[-1] == pytest.approx(V**2 / (p.resistance_ohm_per_m * p.wire_length_m) * r.t[-1],
                                                 rel=1e-9)
 
 
@@ -102,7 +102,7 @@ def test_outputs_are_named_for_the_mechanism(rig):
     r = simulate(rig, "open-loop", voltage="0:0.2", drive="duty", t_end_s=0.01)
     names = r.column_names
     assert names[:4] == ["t_s", "position_m", "position_ref_m", "velocity_m_s"]
-    assert {"T_wire_C", "xi_wire", "force_wire_N", "duty_wire", "energy_wire_J"} <= set(names)
+    assert {"T_wire_C", "xi_wire", "force_wire_N", "duty_wire", "electrical_energy_wire_J", "heat_wire_J"} <= set(names)
     assert not any(n.startswith(("theta", "arm_", "spring_")) for n in names)
 
 

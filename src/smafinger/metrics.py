@@ -230,7 +230,7 @@ class Span:
 
 def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
                     temperature_C: Mapping[str, np.ndarray], energy_J: Mapping[str, np.ndarray],
-                    unit: str = "deg") -> dict:
+                    unit: str = "deg", heat_J: Mapping[str, np.ndarray] | None = None) -> dict:
     """A segment's reach time, overshoot (in the direction of its move), energy and peak
     temperature per wire (``energy_J`` are cumulative signals). ``q`` is the joint angle [deg]
     or a slider's position [m]; ``unit`` names the keys (``target_deg``, ``overshoot_m``)."""
@@ -246,17 +246,22 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         "reached_s": span.reached_s,
         f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
         "energy_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()},
+        **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in heat_J.items()}}
+           if heat_J is not None else {}),
         "peak_temperature_C": {w: float(np.max(T[m])) for w, T in temperature_C.items()},
     }
 
 
 def run_metrics(t: np.ndarray, q: np.ndarray, spans: Sequence[Span],
                 temperature_C: Mapping[str, np.ndarray], stress_Pa: Mapping[str, np.ndarray],
-                energy_J: Mapping[str, np.ndarray], unit: str = "deg") -> dict:
-    """Per-segment metrics, and each wire's energy, peak temperature and peak stress."""
+                energy_J: Mapping[str, np.ndarray], unit: str = "deg",
+                heat_J: Mapping[str, np.ndarray] | None = None) -> dict:
+    """Per-segment metrics, and each wire's energy (electrical, at its terminals; and the heat the
+    model puts into it, if given), peak temperature and peak stress (cumulative energy signals)."""
     return {
-        "segments": [segment_metrics(t, q, s, temperature_C, energy_J, unit) for s in spans],
+        "segments": [segment_metrics(t, q, s, temperature_C, energy_J, unit, heat_J) for s in spans],
         "energy_J": {w: float(e[-1]) for w, e in energy_J.items()},
+        "heat_J": {w: float(e[-1]) for w, e in (heat_J or {}).items()},
         "peak_temperature_C": {w: float(np.max(T)) for w, T in temperature_C.items()},
         "peak_stress_Pa": {w: float(np.max(s)) for w, s in stress_Pa.items()},
     }

@@ -153,7 +153,11 @@ def compute_metrics(result: SimulationResult) -> dict:
     m = run_metrics(result.t, result.signal(f"{p.coordinate.name}_{unit}"), spans,
                     temperature_C={w: result.signal(f"T_{w}_C") for w in wires},
                     stress_Pa={w: result.signal(f"sigma_{w}_Pa") for w in wires},
-                    energy_J={w: result.signal(f"energy_{w}_J") for w in wires}, unit=unit)
+                    energy_J={w: result.signal(f"electrical_energy_{w}_J") for w in wires},
+                    heat_J={w: result.signal(f"heat_{w}_J") for w in wires}, unit=unit)
+    # energy_J is the electrical energy at the terminals (its name since 0.1); heat_J the heat the
+    # model puts into the wires (with the paper's per-metre reading of Eq. 11, 1/L_w^2 times less)
     return {"segments": m["segments"], f"tol_{unit}": spec.tolerance, "hold_s": spec.hold_s,
-            "energy_J": m["energy_J"], "peak_temperature_C": m["peak_temperature_C"],
+            "energy_J": m["energy_J"], "electrical_energy_J": m["energy_J"], "heat_J": m["heat_J"],
+            "peak_temperature_C": m["peak_temperature_C"],
             "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations}

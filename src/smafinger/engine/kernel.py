@@ -19,11 +19,12 @@ from numba import njit
 from ..control.controller import pid_commands, program_commands, viscous_coefficient
 from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
+from ..model.hysteresis_memory import STACK_COLUMNS
 from ..parameters.options import IntegralReset
 from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, track_reach
 from .signals import record_sample
-from .substep import Counters, decide, initial_commands, initial_inputs, initial_state, integrate
+from .substep import STACK_CAPACITY, Counters, decide, initial_commands, initial_inputs, initial_state, integrate
 from .tuples import with_field
 
 
@@ -128,6 +129,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     geom_q = y.q
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
+    stacks = np.zeros((len(model.wires), STACK_CAPACITY, STACK_COLUMNS))  # reversal points, per wire
     n_out = mech_out.shape[0]
     integrating = 1.0
     t, prog_i, next_out, out_i = 0, 0, 0, 0
@@ -159,7 +161,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             b = bounds[j]
             y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives = decide(
                 model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck,
-                v_prev, counters)
+                v_prev, counters, stacks)
             first = False
             if j == 0 and t == next_out and out_i < n_out:
                 record_sample(mech_out, wire_out, out_i, a * run.tick_s, y, aux, s.q_target, s.next_seg - 1,

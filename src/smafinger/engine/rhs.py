@@ -13,7 +13,7 @@ from typing import NamedTuple
 from numba import njit
 
 from ..model.dynamics import angular_acceleration, external_load, wire_load
-from ..model.heat import electrical_power
+from ..model.heat import electrical_power, joule_power_per_m
 from ..model.kinematics import route
 from ..model.records import Aux, State, WireAux, WireState
 from ..model.wire import wire_rates
@@ -53,8 +53,10 @@ def _wire_terms(model, state, inputs, geom, i):
     ws = state.wires[i]
     wi = inputs.wires[i]
     rt = geom.routes[i]
-    dT, dsigma, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, model.options)
-    rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive))
+    opts = model.options
+    dT, dsigma, dTc, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, opts)
+    heat = joule_power_per_m(wire, wi.drive, inputs.current_drive, opts.joule_heating) * wire.wire_length_m
+    rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive), heat, dTc)
     aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt[2], dT)
     return rate, aux, wire_load(sigma, wire.area_m2, rt[1])
 
@@ -62,7 +64,7 @@ def _wire_terms(model, state, inputs, geom, i):
 @njit(cache=True, inline="always")
 def derivative(state, inputs, model, geom):
     """(dstate/dt, aux): the derivative of the state and the algebraic quantities (loads, xi, sigma)."""
-    rates = filled(state.wires, WireState(0.0, 0.0, 0.0))
+    rates = filled(state.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0))
     auxs = filled(state.wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     load = 0.0
     for i in range(len(state.wires)):  # one copy of the wire physics, whatever the wire count

@@ -212,7 +212,7 @@ def describe_state(p: ParameterSet, state) -> str:
              f"error_integral={state.error_integral:.6g}"]
     for name, w in zip(p.wire_names, state.wires):
         parts += [f"T_{name}_C={w.T_C:.6g}", f"sigma_{name}_Pa={w.sigma_Pa:.6g}",
-                  f"energy_{name}_J={w.electrical_J:.6g}"]
+                  f"electrical_energy_{name}_J={w.electrical_J:.6g}", f"T_casing_{name}_C={w.T_case_C:.6g}"]
     return ", ".join(parts)
 
 

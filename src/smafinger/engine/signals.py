@@ -43,7 +43,12 @@ SIGNALS: tuple[Signal, ...] = (
     Signal("V", True, "V", "V_{wire}_V", doc="voltage (current, in A, with a current drive) at the sample"),
     Signal("duty", True, "%", "duty_{wire}", doc="PWM duty DC% (Eq. 12)"),
     # --- added in smafinger 0.2 -------------------------------------------------------------
-    Signal("energy", True, "J", "energy_{wire}_J", doc="electrical energy delivered at the wire's terminals"),
+    Signal("electrical", True, "J", "electrical_energy_{wire}_J",
+           doc="electrical energy delivered at the wire's terminals (V^2 / (R_w L_w), or I^2 R_w L_w, over time)"),
+    Signal("heat", True, "J", "heat_{wire}_J",
+           doc="Joule heat the model puts into the wire (Eq. 11's P' times L_w over time)"),
+    Signal("T_case", True, "degC", "T_casing_{wire}_C",
+           doc="air inside the actuator casing (two-node thermal model; the ambient otherwise)"),
     Signal("load", False, "q-load", "{load}", doc="net load on the mechanism: M_E of Eq. (1b) or the slider's force"),
     Signal("enabled", True, "1", "enabled_{wire}", doc="1 while the wire's actuator is enabled"),
     Signal("heating", True, "1", "heating_{wire}", doc="1 in its controller's heating phase (Sec. 2.6)"),
@@ -125,6 +130,8 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
         wo[i, w, WC.spring] = wa.spring_m
         wo[i, w, WC.V] = drives[w]
         wo[i, w, WC.duty] = cmds[w].duty
-        wo[i, w, WC.energy] = ws.electrical_J
+        wo[i, w, WC.electrical] = ws.electrical_J
+        wo[i, w, WC.heat] = ws.heat_J
+        wo[i, w, WC.T_case] = ws.T_case_C
         wo[i, w, WC.enabled] = 1.0 if cmds[w].enabled else 0.0
         wo[i, w, WC.heating] = 1.0 if cmds[w].heating else 0.0

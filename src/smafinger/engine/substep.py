@@ -13,11 +13,9 @@ from numba import njit
 from ..control.pid import on_time, pwm_output
 from ..control.strategies import Command, opposing_wires_driven
 from ..model.dynamics import at_stop_holding, end_stop, stick_slip
-from ..model.heat import wire_temperature_rate
-from ..model.kinetics import Branch, enter_branch, next_branch
+from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.records import Inputs, State, WireInput, WireState
-from ..model.wire import wire_stress_xi
-from ..parameters.options import FrictionSticking, StressLaw
+from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
 from .integrators import step
 from .rhs import derivative, geometry_at
 from .tuples import filled, set_item, with_field
@@ -31,21 +29,35 @@ class Counters(NamedTuple):
     sticks: int  #: times the mechanism stuck
 
 
+#: rows of each wire's reversal-point stack (return-point memory; merges beyond, docs/hysteresis.md)
+STACK_CAPACITY = 64
+
+
 @njit(cache=True)
 def initial_state(model):
     w = model.wires
-    ws = filled(w, WireState(w[0].T_init_C, w[0].sigma0_Pa, 0.0))
-    for i in range(1, len(w)):
-        ws = set_item(ws, i, WireState(w[i].T_init_C, w[i].sigma0_Pa, 0.0))
+    ws = filled(w, WireState(0.0, 0.0, 0.0, 0.0, 0.0))
+    for i in range(len(w)):
+        ws = set_item(ws, i, WireState(w[i].T_init_C, w[i].sigma0_Pa, 0.0, 0.0, w[i].T_amb_C))
     return State(model.dynamics.q0, 0.0, 0.0, ws)
+
+
+@njit(cache=True)
+def _initial_branch(wire, rule):
+    """A wire at rest on its kinetics branch (model.hysteresis), with the rule's dead band."""
+    if rule == Hysteresis.DEADBAND:
+        return initial_record(DEADBAND, wire.xi_init, wire.T_init_C, wire.minor_loop_reversal_C)[0]
+    code = AUTHORS2020 if rule == Hysteresis.AUTHORS2020 else MEMORY
+    return initial_record(code, wire.xi_init, wire.T_init_C, 0.0)[0]
 
 
 @njit(cache=True)
 def initial_inputs(model, current_drive):
     w = model.wires
-    wi = filled(w, WireInput(0.0, False, Branch(0, w[0].xi_init, w[0].xi_init, w[0].T_init_C)))
+    rule = model.options.hysteresis
+    wi = filled(w, WireInput(0.0, False, _initial_branch(w[0], rule), 0))
     for i in range(1, len(w)):
-        wi = set_item(wi, i, WireInput(0.0, False, Branch(0, w[i].xi_init, w[i].xi_init, w[i].T_init_C)))
+        wi = set_item(wi, i, WireInput(0.0, False, _initial_branch(w[i], rule), 0))
     return Inputs(False, 0.0, model.dynamics.q0, 1.0, current_drive, wi)
 
 
@@ -55,16 +67,31 @@ def initial_commands(model):
 
 
 @njit(cache=True, inline="always")
-def _branch(wire, ws, wi, drive, heating, path, run, opts):
-    """A wire's kinetics branch for the sub-step (MODEL-NOTES: the sign of dT/dt, minor loops)."""
-    dT = wire_temperature_rate(wire, ws.T_C, drive, heating, run.current_drive, opts.joule_heating)
-    b = wi.branch
-    nb, turn = next_branch(b.branch, dT, ws.T_C, b.turn_C, wire.minor_loop_reversal_C)
-    if nb != b.branch:
-        # xi and sigma at the reversal: those of the state on the old branch
-        sigma, xi = wire_stress_xi(wire, ws, b, path, opts.stress_law)
-        return enter_branch(b, nb, turn, xi, ws.T_C, sigma, wire)
-    return Branch(b.branch, b.start, b.held, turn)
+def _branch_moved(a, b):
+    """Did a memory update change how xi is evaluated (not only the extreme reached so far)?"""
+    return not (a.direction == b.direction and a.x0 == b.x0 and a.g0 == b.g0 and a.slope == b.slope
+                and a.target_tau == b.target_tau and a.parent_slope == b.parent_slope)
+
+
+@njit(cache=True, inline="always")
+def _update_kinetics(model, y, inputs, k1, aux, stacks):
+    """Each wire's kinetics branch for the sub-step, from the derivatives at its start (Eqs. 9-10).
+
+    The direction (tau = T - sigma/c rising, falling or neither; the legacy rules: the sign of
+    dT/dt) comes from k1; the memory commits the wipe-outs and reversals at the current point.
+    Returns (inputs, changed): ``changed`` if some wire's branch must be evaluated anew.
+    """
+    wis = inputs.wires
+    changed = False
+    for i in range(len(wis)):
+        wi = wis[i]
+        wire = model.wires[i]
+        d = drive_direction(wi.branch, k1.wires[i].T_C, k1.wires[i].sigma_Pa, wire)
+        rec, depth = update_memory(wi.branch, stacks[i], wi.depth, y.wires[i].T_C, aux.wires[i].sigma_Pa, d,
+                                   wire)
+        changed = changed or _branch_moved(wi.branch, rec)
+        wis = set_item(wis, i, WireInput(wi.drive, wi.heating, rec, depth))
+    return with_field(inputs, "wires", wis), changed
 
 
 @njit(cache=True, inline="always")
@@ -78,8 +105,7 @@ def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, mid
         c = cmds[i]
         d = pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), mid)
         drives = set_item(drives, i, d)
-        br = _branch(w[i], y.wires[i], wis[i], d, c.heating, geom.routes[i][0], run, model.options)
-        wis = set_item(wis, i, WireInput(d, c.heating, br))
+        wis = set_item(wis, i, WireInput(d, c.heating, wis[i].branch, wis[i].depth))
     return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, low
 
 
@@ -90,7 +116,7 @@ def _after_step(model, y, stuck):
     if model.options.stress_law != StressLaw.ALGEBRAIC:
         for i in range(len(ws)):
             if ws[i].sigma_Pa < 0.0:
-                ws = set_item(ws, i, WireState(ws[i].T_C, 0.0, ws[i].electrical_J))
+                ws = set_item(ws, i, WireState(ws[i].T_C, 0.0, ws[i].electrical_J, ws[i].heat_J, ws[i].T_case_C))
     v = 0.0 if stuck else y.v
     q, v = end_stop(y.q, v, model.dynamics)
     return State(q, v, y.error_integral, ws)
@@ -100,15 +126,16 @@ def _after_step(model, y, stuck):
 def _finite(y):
     ok = math.isfinite(y.q) and math.isfinite(y.v) and math.isfinite(y.error_integral)
     for w in y.wires:
-        ok = ok and math.isfinite(w.T_C) and math.isfinite(w.sigma_Pa) and math.isfinite(w.electrical_J)
+        ok = (ok and math.isfinite(w.T_C) and math.isfinite(w.sigma_Pa) and math.isfinite(w.electrical_J)
+              and math.isfinite(w.T_case_C))
     return ok
 
 
 @njit(cache=True, inline="always")
 def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck, v_prev,
-           counters):
-    """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, branches,
-    stick/slip (Eq. 2), and the derivative there.
+           counters, stacks):
+    """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, kinetics
+    branches (Eqs. 9-10), stick/slip (Eq. 2), and the derivative there.
 
     Returns (y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives).
     """
@@ -118,14 +145,23 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
                                        0.5 * (a + b) - ps, stuck)
     if opposing_wires_driven(model.wires, drives, low) and b > a:
         counters = with_field(counters, "violations", counters.violations + 1)
-    # Eq. (2) at the sub-step start; if the stick state changes, the derivative is evaluated again
+    # the derivative at the sub-step start; then the kinetics branches and Eq. (2) are decided from
+    # it, and whenever a decision changes what the derivative depends on it is evaluated again
     restick = model.options.friction_sticking == FrictionSticking.RESTICK
     evals = counters.evals
-    for attempt in range(2):  # one call site: derivative is compiled inline once here
+    kinetics_done = False
+    stick_done = False
+    for _ in range(3):  # one call site: derivative is compiled inline once here
         k1, aux = derivative(y, inputs, model, geom)
         evals += 1
-        if attempt == 1:
+        if not kinetics_done:
+            kinetics_done = True
+            inputs, changed = _update_kinetics(model, y, inputs, k1, aux, stacks)
+            if changed:
+                continue
+        if stick_done:
             break
+        stick_done = True
         new_stuck = (stick_slip(stuck, first, aux.load, y.v, v_prev, model.dynamics, restick)
                      or at_stop_holding(y.q, aux.load, model.dynamics))
         if new_stuck == stuck:

@@ -46,7 +46,12 @@ def spring_force(x, K_S, x_limit, fact):
 
 @njit(cache=True)
 def spring_elongation(F, K_S, x_limit, fact):
-    """Inverse of :func:`spring_force` (Newton from the linear guess; F >= 0)."""
+    """Inverse of :func:`spring_force` (F >= 0).
+
+    Newton from the linear guess (a few iterations where the slack has not stiffened the spring
+    much); far up the cosh stiffening Newton from there moves too little per iteration, so if it
+    has not converged in 60 the root is bracketed and found by bisection-safeguarded Newton.
+    """
     if F <= 0.0:
         return 0.0
     x = F / K_S
@@ -58,7 +63,30 @@ def spring_elongation(F, K_S, x_limit, fact):
         step = r / k
         x -= step
         if abs(step) < 1e-15:
-            break
+            return x
+    return _spring_elongation_bracketed(F, K_S, x_limit, fact)
+
+
+@njit(cache=True)
+def _spring_elongation_bracketed(F, K_S, x_limit, fact):
+    """The root of spring_force(x) = F beyond x_limit, bracketed (spring_force increases with x)."""
+    lo = max(x_limit, 0.0)
+    hi = lo + 1e-3
+    while spring_force(hi, K_S, x_limit, fact) < F:
+        lo, hi = hi, lo + 2.0 * (hi - lo)
+    x = 0.5 * (lo + hi)
+    for _ in range(200):
+        r = spring_force(x, K_S, x_limit, fact) - F
+        if r > 0.0:
+            hi = x
+        else:
+            lo = x
+        x_new = x - r / spring_stiffness(x, K_S, x_limit, fact)
+        if not (lo < x_new < hi):
+            x_new = 0.5 * (lo + hi)
+        if abs(x_new - x) <= 1e-15 * (1.0 + abs(x)):
+            return x_new
+        x = x_new
     return x
 
 

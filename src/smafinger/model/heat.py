@@ -18,7 +18,7 @@ heating ones while the wire's controller is in its heating phase and the cooling
 
 from numba import njit
 
-from ..parameters.options import JouleHeating
+from ..parameters.options import JouleHeating, ThermalModel
 
 
 @njit(cache=True, inline="always")
@@ -52,15 +52,58 @@ def heat_balance(T, P, h, T_amb, M_w, C_p, A_w):
 
 
 @njit(cache=True, inline="always")
-def wire_temperature_rate(wire, T, drive, heating, current_drive, reading):
-    """Eq. (11) for a wire, with the heating or cooling coefficients of its phase."""
+def wire_h(wire, T, heating):
+    """h of Eq. (11) with the heating or cooling coefficients of the wire's phase (Sec. 3.2)."""
     if heating:
-        h = convection_coefficient(T, wire.h0_heating_W_m2K, wire.h2_heating_W_m2K3)
-    else:
-        h = convection_coefficient(T, wire.h0_cooling_W_m2K, wire.h2_cooling_W_m2K3)
-    P = joule_power_per_m(wire, drive, current_drive, reading)
-    return heat_balance(T, P, h, wire.T_amb_C, wire.mass_per_length_kg_m, wire.specific_heat_J_kgK,
-                        wire.perimeter_m)
+        return convection_coefficient(T, wire.h0_heating_W_m2K, wire.h2_heating_W_m2K3)
+    return convection_coefficient(T, wire.h0_cooling_W_m2K, wire.h2_cooling_W_m2K3)
+
+
+@njit(cache=True, inline="always")
+def surroundings_C(wire, T_case, model):
+    """The temperature the wire loses heat to: the ambient (Eq. 11) or the casing air (two-node)."""
+    return T_case if model == ThermalModel.TWO_NODE else wire.T_amb_C
+
+
+@njit(cache=True, inline="always")
+def wire_temperature_rate(wire, T, T_case, drive, heating, current_drive, opts):
+    """Eq. (11) for a wire, with the heating or cooling coefficients of its phase (no latent heat)."""
+    h = wire_h(wire, T, heating)
+    P = joule_power_per_m(wire, drive, current_drive, opts.joule_heating)
+    return heat_balance(T, P, h, surroundings_C(wire, T_case, opts.thermal_model), wire.mass_per_length_kg_m,
+                        wire.specific_heat_J_kgK, wire.perimeter_m)
+
+
+@njit(cache=True, inline="always")
+def casing_temperature_rate(wire, T, T_case, heating, opts):
+    """dT_case/dt of the two-node model: C_case dT_case/dt = h A_w (T - T_case) - G (T_case - T_amb).
+
+    Per metre of wire: C_case = ``casing_heat_capacity_J_mK``, G = ``casing_loss_W_mK``; the wire
+    side is Eq. (11)'s convection term, now to the casing air (Sec. 3.2: "heat transfer between
+    SMA wire and the inside air of the actuator, and ... the inside air and the open air").
+    0 in the single-node model.
+    """
+    if opts.thermal_model != ThermalModel.TWO_NODE:
+        return 0.0
+    q_in = wire_h(wire, T, heating) * wire.perimeter_m * (T - T_case)
+    q_out = wire.casing_loss_W_mK * (T_case - wire.T_amb_C)
+    return (q_in - q_out) / wire.casing_heat_capacity_J_mK
+
+
+@njit(cache=True, inline="always")
+def latent_heat_rate(dT_no_latent, dsigma_free, dsigma_dT, xi_T, xi_s, wire):
+    """dT/dt with the latent heat of the transformation (Eq. 11 plus M_w dH dxi/dt).
+
+    Forming martensite (dxi/dt > 0) releases the latent heat dH per kilogram, reversing it absorbs
+    it: M_w C_p dT/dt = (Eq. 11's right-hand side) + M_w dH (xi_T dT/dt + xi_s dsigma/dt), with
+    dsigma/dt = ``dsigma_free`` - ``dsigma_dT`` dT/dt from the constitutive law; solved for dT/dt.
+    ``latent_heat_J_kg`` = 0 (the paper's sets) returns ``dT_no_latent`` unchanged.
+    """
+    dH = wire.latent_heat_J_kg
+    if dH == 0.0:
+        return dT_no_latent
+    r = dH / wire.specific_heat_J_kgK
+    return (dT_no_latent + r * xi_s * dsigma_free) / (1.0 - r * xi_T + r * xi_s * dsigma_dT)
 
 
 def steady_state_temperature(P, h, T_amb, A_w):

@@ -7,34 +7,20 @@ Cooling (Eq. 10): M_S = M_S0 + sigma/c_M, M_F = M_F0 + sigma/c_M and
     xi = (1 - xi_A0)/2 cos[a_M (T - M_F0) + b_M sigma] + (1 + xi_A0)/2
        = xi_A0 + (1 - xi_A0) g_M(T, sigma),  g_M = 0 above M_S, 1 below M_F.
 
-Branch: heating while dT/dt > 0, cooling while dT/dt < 0, xi held when dT/dt = 0.
-Minor loops (MODEL-NOTES): the start value of the branch being entered (xi_M0 or xi_A0) is
-re-solved from the current xi, T and sigma, so xi is continuous through every reversal.
-For a major loop xi_M0 = 1 and xi_A0 = 0.
+These are the major curves and the legacy branch rules (the authors' 2020 model: heating while
+dT/dt > 0, cooling while dT/dt < 0, xi held when dT/dt = 0, the start value of the branch being
+entered re-solved from the current xi so that xi is continuous; smafinger 0.1's dead band).
+Minor loops with return-point memory, the default, and the engine's interface to all the
+rules are in :mod:`smafinger.model.hysteresis`.
 """
 
 import math
-from typing import NamedTuple
 
 from numba import njit
 
 HOLD = 0
 HEATING = 1
 COOLING = 2
-
-
-class Branch(NamedTuple):
-    """A wire's kinetics branch, held over a sub-step (minor loops: MODEL-NOTES)."""
-
-    branch: int  #: HOLD, HEATING or COOLING
-    start: float  #: xi_M0 on the heating branch (Eq. 9b), xi_A0 on the cooling branch (Eq. 10b)
-    held: float  #: xi on the hold branch
-    turn_C: float  #: extreme temperature since the last change (dead-band rule)
-
-
-def initial_branch(xi_init: float, T_init_C: float) -> Branch:
-    """A wire at rest: on the hold branch at its initial xi."""
-    return Branch(HOLD, xi_init, xi_init, T_init_C)
 
 
 @njit(cache=True, inline="always")
@@ -155,24 +141,3 @@ def branch_of(dT_dt):
     if dT_dt < 0.0:
         return COOLING
     return HOLD
-
-
-@njit(cache=True, inline="always")
-def xi_on_branch(b, T, sigma, wire):
-    """xi and its partials (dxi/dT, dxi/dsigma) of a wire on branch ``b`` (Eqs. 9b, 10b)."""
-    return martensite_fraction(b.branch, b.start, b.held, T, sigma, wire.A_S0_C, wire.A_F0_C,
-                               wire.c_A_Pa_per_C, wire.M_S0_C, wire.M_F0_C, wire.c_M_Pa_per_C)
-
-
-@njit(cache=True)
-def enter_branch(b, new_branch, turn_C, xi_now, T, sigma, wire):
-    """The branch record on entering ``new_branch`` with xi = ``xi_now`` at (T, sigma).
-
-    The start value is re-solved so that the new branch passes through xi_now (continuous xi
-    through the reversal); on the hold branch xi stays at xi_now.
-    """
-    if new_branch == HOLD:
-        return Branch(new_branch, b.start, xi_now, turn_C)
-    start = branch_start(new_branch, xi_now, T, sigma, wire.A_S0_C, wire.A_F0_C, wire.c_A_Pa_per_C,
-                         wire.M_S0_C, wire.M_F0_C, wire.c_M_Pa_per_C)
-    return Branch(new_branch, start, b.held, turn_C)

@@ -20,7 +20,6 @@ from dataclasses import fields
 from typing import Any, NamedTuple
 
 from ..parameters.base import ParameterSet
-from .kinetics import Branch
 
 #: derived per-wire quantities: (name, meaning). Computed in :mod:`smafinger.model.build`.
 WIRE_DERIVED: tuple[tuple[str, str], ...] = (
@@ -108,6 +107,8 @@ class WireState(NamedTuple):
     T_C: float  #: temperature
     sigma_Pa: float  #: stress (rate law; unused by the algebraic law)
     electrical_J: float  #: electrical energy delivered at its terminals
+    heat_J: float  #: Joule heat the model puts into the wire (Eq. 11's P' times L_w)
+    T_case_C: float  #: air inside the actuator casing (two-node model; the ambient otherwise)
 
 
 class State(NamedTuple):
@@ -124,7 +125,8 @@ class WireInput(NamedTuple):
 
     drive: float  #: applied voltage [V] (or current [A] with a current drive)
     heating: bool  #: its controller's heating phase (selects h, Eq. 11)
-    branch: Branch  #: kinetics branch (Eqs. 9-10)
+    branch: object  #: kinetics branch, model.hysteresis.BranchRecord (Eqs. 9-10)
+    depth: int  #: rows in use of the wire's reversal-point stack (return-point memory)
 
 
 class Inputs(NamedTuple):

@@ -9,8 +9,8 @@ from numba import njit
 
 from ..parameters.options import StressLaw
 from .constitutive import rate_law_modulus, secant_modulus, stress_rate, youngs_modulus
-from .heat import wire_temperature_rate
-from .kinetics import xi_on_branch
+from .heat import casing_temperature_rate, latent_heat_rate, wire_temperature_rate
+from .hysteresis import xi_on_branch
 
 
 @njit(cache=True)
@@ -87,16 +87,6 @@ def total_strain(wire, path):
 
 
 @njit(cache=True, inline="always")
-def rate_law(wire, sigma, T, dT, branch, dpath, v):
-    """Rate-form law (Eq. 7b) for one wire: (dsigma/dt, xi, spring elongation)."""
-    xi, xT, xs = xi_on_branch(branch, T, sigma, wire)
-    D = youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa)
-    D_eq, x_s = rate_law_modulus(wire, sigma, D)
-    deps = dpath * v / wire.wire_length_m  # Eq. (6): Delta eps = Delta path / L_w
-    return stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma), xi, x_s
-
-
-@njit(cache=True, inline="always")
 def wire_stress_xi(wire, ws, branch, path, stress_law):
     """(sigma, xi) of a wire at its state: the state's stress (rate law) or the solved one."""
     if stress_law == StressLaw.ALGEBRAIC:
@@ -107,16 +97,26 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
 
 @njit(cache=True, inline="always")
 def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
-    """A wire's (dT/dt, dsigma/dt, electrical power) and (xi, sigma, spring elongation).
+    """A wire's (dT/dt, dsigma/dt, dT_case/dt) and (sigma, xi, spring elongation).
 
     ``route_now`` = (path, dpath/dq, arm) at the current q; ``wi`` the wire's held inputs.
+    Rate law: dsigma/dt of Eq. (7b) with dxi/dt = xi_T T' + xi_sigma sigma'; with the latent heat
+    on, T' and sigma' are solved together. Algebraic law: sigma solved with xi; the latent heat
+    then takes dxi/dt = xi_T T' (sigma's own rate is not part of the state).
     """
     path, dpath, _ = route_now
-    dT = wire_temperature_rate(wire, ws.T_C, wi.drive, wi.heating, current_drive, opts.joule_heating)
+    T = ws.T_C
+    dT0 = wire_temperature_rate(wire, T, ws.T_case_C, wi.drive, wi.heating, current_drive, opts)
+    dTc = casing_temperature_rate(wire, T, ws.T_case_C, wi.heating, opts)
     if opts.stress_law == StressLaw.ALGEBRAIC:
-        sigma, xi, x_s = algebraic_stress(wire, total_strain(wire, path), ws.T_C, wi.branch)
-        dsigma = 0.0
-    else:
-        sigma = ws.sigma_Pa
-        dsigma, xi, x_s = rate_law(wire, sigma, ws.T_C, dT, wi.branch, dpath, v)
-    return dT, dsigma, sigma, xi, x_s
+        sigma, xi, x_s = algebraic_stress(wire, total_strain(wire, path), T, wi.branch)
+        if wire.latent_heat_J_kg != 0.0:
+            dT0 = latent_heat_rate(dT0, 0.0, 0.0, xi_on_branch(wi.branch, T, sigma, wire)[1], 0.0, wire)
+        return dT0, 0.0, dTc, sigma, xi, x_s
+    sigma = ws.sigma_Pa
+    xi, xT, xs = xi_on_branch(wi.branch, T, sigma, wire)
+    D_eq, x_s = rate_law_modulus(wire, sigma, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))
+    deps = dpath * v / wire.wire_length_m  # Eq. (6): Delta eps = Delta path / L_w
+    den = 1.0 + D_eq * wire.eps_R * xs
+    dT = latent_heat_rate(dT0, D_eq * deps / den, D_eq * wire.eps_R * xT / den, xT, xs, wire)
+    return dT, stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma), dTc, sigma, xi, x_s

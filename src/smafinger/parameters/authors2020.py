@@ -37,5 +37,6 @@ def parameters() -> JointParameters:
         friction_sticking="initial-only",
         damping_switch="enabled",
         minor_loop_reversal_C=0.0,
+        hysteresis="authors2020",
         **{k: v for k, v in GEOMETRY.items()},
     )

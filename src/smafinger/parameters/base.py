@@ -68,8 +68,8 @@ class ParameterSet:
     xi_init: float = _num(0.0, 1.0, "initial martensite fraction of every wire", wire=True)
     minor_loop_reversal_C: float = _num(
         0.0, 50.0,
-        "temperature reversal needed to switch kinetics branch (0: sign of dT/dt, authors' model; "
-        ">0 keeps PWM ripple from ratcheting xi through minor loops)", wire=True,
+        "dead band of the 'deadband' hysteresis rule (smafinger 0.1): the temperature reversal that "
+        "switches the kinetics branch", wire=True,
     )
 
     # --- heat transfer (Eq. 11) -----------------------------------------------------------
@@ -79,6 +79,16 @@ class ParameterSet:
     h2_heating_W_m2K3: float = _num(0.0, 1.0, "h2 while the actuator is heating", wire=True)
     h0_cooling_W_m2K: float = _num(0.0, 1e4, "h0 while the actuator is cooling or off", wire=True)
     h2_cooling_W_m2K3: float = _num(0.0, 1.0, "h2 while the actuator is cooling or off", wire=True)
+    latent_heat_J_kg: float = _num(
+        0.0, 1e6, "latent heat of the transformation (0: off, as in the paper; NiTi: about 24e3)",
+        wire=True, default=0.0)
+    # two-node model (thermal_model = "two-node"): wire -> casing air -> open air, per metre of wire
+    casing_heat_capacity_J_mK: float = _num(
+        1e-6, 1e6, "heat capacity of the actuator casing and its air, per metre of wire (two-node model)",
+        wire=True, default=20.0)
+    casing_loss_W_mK: float = _num(
+        0.0, 1e4, "heat loss of the casing to the open air per kelvin, per metre of wire (two-node model)",
+        wire=True, default=0.08)
 
     # --- drive and controller (Eq. 12, Sec. 2.6) -------------------------------------------
     V_H_V: float = _num(0.0, 100.0, "PWM high voltage V_H (the supply)")

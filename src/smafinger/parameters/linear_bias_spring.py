@@ -27,7 +27,8 @@ MODEL-NOTES), integral anti-windup on.
 
 from .mechanisms import LinearActuatorParameters
 from .options import (
-    AntiWindup, DampingSwitch, FrictionSticking, IntegralReset, JouleHeating, ModelOptions, SpringInit, StressLaw,
+    AntiWindup, DampingSwitch, FrictionSticking, Hysteresis, IntegralReset, JouleHeating, ModelOptions, SpringInit,
+    StressLaw, ThermalModel,
 )
 
 SOURCE = ("Template bench rig: Dynalloy Flexinol 0.5 mm wire data; Gilardi et al. 2010 Table II (c_A, c_M); "
@@ -42,6 +43,8 @@ OPTIONS = ModelOptions(
     anti_windup=AntiWindup.CLAMP,
     controller_in_cooling=True,
     joule_heating=JouleHeating.WHOLE_WIRE,
+    hysteresis=Hysteresis.MEMORY,
+    thermal_model=ThermalModel.SINGLE_NODE,
 )
 
 

@@ -37,6 +37,9 @@ class Option(IntEnum):
             return self.label == other
         return int.__eq__(self, other)
 
+    def __ne__(self, other: object) -> bool:
+        return not self.__eq__(other)
+
     __hash__ = IntEnum.__hash__
 
     @classmethod
@@ -81,6 +84,22 @@ class DampingSwitch(Option):
 
     HEATING_PHASE = 0  #: heating value while any wire is in its controller's heating phase
     ENABLED = 1  #: heating value while any wire is enabled (authors' 2020 model)
+    HEATING_VALUE = 2  #: the heating value throughout (no switching)
+
+
+class Hysteresis(Option):
+    """Minor hysteresis loops of the phase kinetics (Eqs. 9-10; MODEL-NOTES, docs/hysteresis.md)."""
+
+    MEMORY = 0  #: return-point memory (a stack of reversal points): the default
+    AUTHORS2020 = 1  #: the authors' 2020 model: branch from the sign of dT/dt, start re-solved
+    DEADBAND = 2  #: smafinger 0.1: the authors' rule with a reversal of minor_loop_reversal_C
+
+
+class ThermalModel(Option):
+    """Heat transfer of a wire (Eq. 11; Sec. 3.2 and Fig. 10a)."""
+
+    SINGLE_NODE = 0  #: Eq. (11): the wire exchanges heat with the ambient directly
+    TWO_NODE = 1  #: wire -> air inside the actuator casing -> open air (Sec. 3.2)
 
 
 class IntegralReset(Option):
@@ -121,6 +140,8 @@ class ModelOptions:
     controller_in_cooling: bool = field(metadata={
         "kind": "bool", "doc": "keep the PID on in an actuator's cooling phase (False: 0 V, Fig. 11)"})
     joule_heating: JouleHeating = _choice(JouleHeating, "how the drive heats a wire, Eq. (11)")
+    hysteresis: Hysteresis = _choice(Hysteresis, "minor loops of the phase kinetics, Eqs. (9)-(10)")
+    thermal_model: ThermalModel = _choice(ThermalModel, "heat transfer of a wire, Eq. (11)")
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -153,6 +174,8 @@ OPTION_TYPES: dict[str, type[Option]] = {
     "integral_reset": IntegralReset,
     "anti_windup": AntiWindup,
     "joule_heating": JouleHeating,
+    "hysteresis": Hysteresis,
+    "thermal_model": ThermalModel,
 }
 OPTION_NAMES = tuple(f.name for f in fields(ModelOptions))
 

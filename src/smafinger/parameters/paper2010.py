@@ -26,7 +26,8 @@ phases, as used in the parametric analysis of Sec. 3.1 (Figs. 7-8).
 from .geometry import GEOMETRY
 from .mechanisms import JointParameters
 from .options import (
-    AntiWindup, DampingSwitch, FrictionSticking, IntegralReset, JouleHeating, ModelOptions, SpringInit, StressLaw,
+    AntiWindup, DampingSwitch, FrictionSticking, Hysteresis, IntegralReset, JouleHeating, ModelOptions, SpringInit,
+    StressLaw, ThermalModel,
 )
 
 SOURCE = "Gilardi et al., Robotica 28(5):675-687, 2010, Table II and Sec. 3.2"
@@ -42,6 +43,8 @@ OPTIONS = ModelOptions(
     anti_windup=AntiWindup.NONE,
     controller_in_cooling=True,
     joule_heating=JouleHeating.PER_METRE,
+    hysteresis=Hysteresis.MEMORY,
+    thermal_model=ThermalModel.SINGLE_NODE,
 )
 
 
