@@ -105,6 +105,26 @@ def martensite_fraction(k: Kinetics, T: float, sigma: float, m: Transformation) 
     return xi, xT, xs
 
 
+def partial_amplitudes(k: Kinetics, T: float, sigma: float, m: Transformation) -> tuple[float, float]:
+    """Largest |dxi/dT| and |dxi/dsigma| of the curve ``k`` follows, 0 outside its band.
+
+    Inside a band the partials are a sine of an argument that has round-off of its own: near
+    the band's ends, where the sine is small, their round-off is that of these amplitudes.
+    """
+    if k.phase is Phase.HOLD:
+        return 0.0, 0.0
+    if k.phase is Phase.HEATING:
+        g, gT, _ = heating_curve(T, sigma, m)
+        amp, width, c = abs(k.start), m.A_F0 - m.A_S0, m.c_A
+    else:
+        g, gT, _ = cooling_curve(T, sigma, m)
+        amp, width, c = abs(1.0 - k.start), m.M_S0 - m.M_F0, m.c_M
+    if gT == 0.0 and g in (0.0, 1.0):
+        return 0.0, 0.0
+    a = 0.5 * math.pi / width * amp
+    return a, a / c
+
+
 def start_through(phase: Phase, xi: float, T: float, sigma: float, m: Transformation) -> float:
     """The start value that puts the curve of ``phase`` through xi at (T, sigma) (minor loops).
 

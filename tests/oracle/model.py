@@ -155,8 +155,9 @@ class Held:
 
 @dataclass
 class Derivative:
-    """Named rates, named algebraic outputs and (if asked for) the magnitude scale of each."""
+    """Named rates, named algebraic outputs and (if asked for) the round-off scale of each."""
 
     rates: dict[str, float] = field(default_factory=dict)
     outputs: dict[str, float] = field(default_factory=dict)
-    scales: dict[str, float] | None = None
+    rate_scales: dict[str, float] | None = None
+    output_scales: dict[str, float] | None = None

@@ -11,7 +11,7 @@ def _wire(m: OracleModel, w: Wire, ws: WireVars, wh: WireHeld, geo, v: float, cu
           prefix: str) -> float:
     """One wire's rates and outputs into ``d``; returns its generalized force (F times the arm)."""
     path, dpath, arm = geo
-    sc = d.scales
+    sc = d.rate_scales
     # Eq. (11)
     P = mech.joule_power_per_metre(wh.drive, current, m.whole_wire, w.R_per_m, w.L_w)
     h = mech.convection(ws.T, *(w.h_heating if wh.heating else w.h_cooling))
@@ -35,9 +35,10 @@ def _wire(m: OracleModel, w: Wire, ws: WireVars, wh: WireHeld, geo, v: float, cu
             D_eq = mat.series_modulus(mat.spring_stiffness(x_s, w.spring), D, w.S_w, w.L_w)
         strain_rate = dpath * v / w.L_w  # Eq. (6)
         dsigma = mat.stress_rate(D_eq, strain_rate, w.eps_R, xi_T, xi_s, dT, sigma)
-        if sc is not None:
-            sc[prefix + "sigma"] = (D_eq * (abs(strain_rate) + w.eps_R * abs(xi_T * dT))
-                                    / abs(1.0 + D_eq * w.eps_R * xi_s))
+        if sc is not None:  # numerator and denominator each to round-off of their terms
+            amp_T, amp_s = mat.partial_amplitudes(wh.kinetics, ws.T, sigma, w.transformation)
+            sc[prefix + "sigma"] = ((D_eq * (abs(strain_rate) + w.eps_R * amp_T * abs(dT))
+                                     + abs(dsigma) * D_eq * w.eps_R * amp_s) / abs(1.0 + D_eq * w.eps_R * xi_s))
     force = sigma * w.S_w
     d.rates.update({prefix + "T": dT, prefix + "sigma": dsigma, prefix + "energy": power})
     if sc is not None:
@@ -46,8 +47,8 @@ def _wire(m: OracleModel, w: Wire, ws: WireVars, wh: WireHeld, geo, v: float, cu
     outputs = {"xi": xi, "sigma": sigma, "force": force, "spring": x_s, "arm": abs(arm)}
     for k, value in outputs.items():
         d.outputs[prefix + k] = value
-    if sc is not None:  # outputs: the scale of a value is its size (xi: 1)
-        sc.update({prefix + k: (1.0 if k == "xi" else abs(value)) for k, value in outputs.items()})
+    if d.output_scales is not None:  # outputs: the scale of a value is its size (xi: 1)
+        d.output_scales.update({prefix + k: (1.0 if k == "xi" else abs(value)) for k, value in outputs.items()})
     return force * arm
 
 
@@ -60,7 +61,7 @@ def derivative(m: OracleModel, s: Vars, u: Held, scales: bool = False) -> Deriva
     value is the sum of the magnitudes of the terms it is computed from: its round-off is a
     few units of 1e-16 of that.
     """
-    d = Derivative(scales={} if scales else None)
+    d = Derivative(rate_scales={} if scales else None, output_scales={} if scales else None)
     mc = m.mechanism
     terms = [_wire(m, w, ws, wh, geo, s.v, u.current, d, w.name + ".")
              for w, ws, wh, geo in zip(m.wires, s.wires, u.wires, mc.wire_geometry(s.q))]
@@ -73,6 +74,7 @@ def derivative(m: OracleModel, s: Vars, u: Held, scales: bool = False) -> Deriva
     if scales:
         load_scale = sum(abs(f) for f in terms) + abs(external)
         friction = 0.0 if u.stuck else mech.sliding_friction(s.v, mc.dynamic, u.viscous)
-        d.scales.update({"load": load_scale, "q": abs(s.v), "v": (load_scale + abs(friction)) / mc.inertia,
-                         "error_integral": (abs(u.q_target) + abs(s.q)) * abs(u.integrating)})
+        d.output_scales["load"] = load_scale
+        d.rate_scales.update({"q": abs(s.v), "v": (load_scale + abs(friction)) / mc.inertia,
+                              "error_integral": (abs(u.q_target) + abs(s.q)) * abs(u.integrating)})
     return d
