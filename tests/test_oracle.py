@@ -63,7 +63,7 @@ def oracle_values(p, s: Vars, u: Held) -> tuple[dict[str, float], dict[str, floa
     """(values, scales) of the oracle's derivative, keyed as :func:`engine_values`."""
     d = oracle.derivative(oracle.build(p), s, u, scales=True)
     values = {"rate." + k: v for k, v in d.rates.items()} | {"out." + k: v for k, v in d.outputs.items()}
-    scales = {"rate." + k: d.scales[k] for k in d.rates} | {"out." + k: d.scales[k] for k in d.outputs}
+    scales = {"rate." + k: v for k, v in d.rate_scales.items()} | {"out." + k: v for k, v in d.output_scales.items()}
     return values, scales
 
 
@@ -101,6 +101,20 @@ def parameter_sets(draw):
     return base.replace(**changes)
 
 
+def temperatures(p, sigma):
+    """Anywhere from -20 to 250 degC, or around either transformation band shifted by sigma (Eqs. 9-10).
+
+    Inside a band xi depends on T and sigma, which brings in the coupling terms of Eq. (7b);
+    uniform draws over the whole range would seldom land there.
+    """
+    def band(lo, hi, c):
+        shift = sigma / c
+        return st.floats(lo + shift - 0.2 * (hi - lo), hi + shift + 0.2 * (hi - lo))
+
+    return st.one_of(st.floats(-20.0, 250.0), band(p.A_S0_C, p.A_F0_C, p.c_A_Pa_per_C),
+                     band(p.M_F0_C, p.M_S0_C, p.c_M_Pa_per_C))
+
+
 @st.composite
 def cases(draw):
     p = draw(parameter_sets())
@@ -110,12 +124,15 @@ def cases(draw):
     q = draw(st.floats(*q_range))
     v = draw(st.one_of(st.just(0.0), st.floats(-5.0, 5.0) if joint else st.floats(-0.5, 0.5)))
     sigma_max = JOINT_SIGMA_MAX_PA if joint else 6e8
-    wires = tuple(WireVars(draw(st.floats(-20.0, 250.0)), draw(st.floats(-0.25 * sigma_max, sigma_max)),
-                           draw(st.floats(0.0, 1e3))) for _ in range(n))
-    s = Vars(q, v, draw(st.floats(-10.0, 10.0)), wires)
+    wires = []
+    for _ in range(n):
+        sigma = draw(st.floats(-0.25 * sigma_max, sigma_max))
+        wires.append(WireVars(draw(temperatures(p, sigma)), sigma, draw(st.floats(0.0, 1e3))))
+    s = Vars(q, v, draw(st.floats(-10.0, 10.0)), tuple(wires))
     current = draw(st.booleans())
     held = tuple(WireHeld(draw(st.floats(0.0, 3.0 if current else 15.0)), draw(st.booleans()),
-                          Kinetics(draw(st.sampled_from(list(Phase))), draw(st.floats(-0.5, 1.5)),
+                          Kinetics(draw(st.sampled_from(list(Phase))),
+                                   draw(st.one_of(st.floats(0.0, 1.0), st.floats(-0.5, 1.5))),
                                    draw(st.floats(0.0, 1.0)))) for _ in range(n))
     u = Held(draw(st.booleans()), draw(st.floats(0.0, 0.2) if joint else st.floats(0.0, 5.0)),
              draw(st.floats(*q_range)), draw(st.sampled_from((0.0, 1.0))), current, held)
