@@ -171,7 +171,7 @@ def spring_elongation(F: float, s: SpringSlack) -> float:
     if F <= 0.0:
         return 0.0
     lin = F / s.K
-    if lin <= s.knee or s.per_mm == 0.0:
+    if lin <= s.knee or s.per_mm == 0.0 or spring_force(lin, s) <= F:  # (the last: stiffening below round-off)
         return lin
     # the stiffening spring stretches less than the linear one, and beyond the knee
     return brentq(lambda x: spring_force(x, s) - F, s.knee, lin, xtol=1e-300, rtol=1e-15, maxiter=200)
@@ -231,7 +231,7 @@ def algebraic_stress(eps: float, T: float, k: Kinetics, m: Transformation, D_A: 
     top = implied(0.0)
     if top[0] <= 0.0:
         return top
-    if top[0] - implied(top[0])[0] == 0.0:
+    if top[0] - implied(top[0])[0] <= 0.0:  # xi does not depend on sigma here: S is constant
         sigma = top[0]
     else:
         sigma = brentq(lambda s: s - implied(s)[0], 0.0, top[0], xtol=1e-300, rtol=1e-15, maxiter=500)
