@@ -15,10 +15,10 @@
    saved), measured with the simulations replaced by their recorded rows: how many
    workers one client keeps busy (goal: >= 0.8 x the cores of the cluster).
 4. Engine vs a straightforward SciPy ``solve_ivp`` implementation of the same model
-   (``benchmarks/scipy_baseline.py``: plain-Python right-hand side) on the same case: the
+   (the test oracle, ``tests/oracle``: plain-Python right-hand side) on the same case: the
    upper wire at 8 V for 6 s, then off, to 20 s (``voltage="0:8:0,6:0:0"``, parameter set
-   ``paper2010`` with ``minor_loop_reversal_C = 0``, the branch rule the baseline
-   implements). Goal: >= 200x. Accuracy: max |theta - theta_ref| on a 10 ms grid, with
+   ``paper2010`` with ``minor_loop_reversal_C = 0``, the sign-of-dT/dt branch rule).
+   Goal: >= 200x. Accuracy: max |theta - theta_ref| on a 10 ms grid, with
    theta_ref from the baseline at rtol = 1e-10 (LSODA). A second case drives the same wire
    with a PWM program (80 % duty, 1 ms period, for 8 s) to show the cost of discontinuities.
 
@@ -47,7 +47,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "src"))
-sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))
 
 from smafinger import simulate  # noqa: E402
 from smafinger.analysis.sweep import load_spec, metrics_row  # noqa: E402
@@ -55,7 +55,7 @@ from smafinger.engine import batch  # noqa: E402
 from smafinger.engine.run import make_spec, run_spec  # noqa: E402
 from smafinger.parameters import get  # noqa: E402
 
-import scipy_baseline  # noqa: E402
+from oracle import simulate_baseline  # noqa: E402
 
 FIG8 = HERE.parent / "examples" / "sweep-fig8.toml"
 
@@ -127,7 +127,7 @@ def bench_scipy(repeat: int, quick: bool) -> dict:
     for name, voltage in cases:
         print(f"\n[4] engine vs scipy solve_ivp, open loop, {name}, paper2010, 20 s")
         eng_s, kern_s, t, th_eng = _engine_case(p, voltage, repeat * 2)
-        t_ref, th_ref, info_ref = scipy_baseline.simulate_baseline(p, voltage, method="LSODA", rtol=1e-10)
+        t_ref, th_ref, info_ref = simulate_baseline(p, voltage, method="LSODA", rtol=1e-10)
         assert np.allclose(t, t_ref)
         fine = simulate(p, "open-loop", voltage=voltage, t_end_s=20.0, dt_s=1e-4, output_interval_s=1e-3)
         err_eng = float(np.max(np.abs(th_eng - th_ref)))
@@ -140,7 +140,7 @@ def bench_scipy(repeat: int, quick: bool) -> dict:
         for method, rtol in (("RK45", 1e-3), ("RK45", 1e-6), ("LSODA", 1e-6)):
             if voltage != "0:8:0,6:0:0" and rtol == 1e-3:
                 continue
-            _, th, info = scipy_baseline.simulate_baseline(p, voltage, method=method, rtol=rtol)
+            _, th, info = simulate_baseline(p, voltage, method=method, rtol=rtol)
             err = float(np.nanmax(np.abs(th - th_ref)))
             ratio = info["wall_s"] / eng_s
             rows.append((method, rtol, info["wall_s"], err, ratio))
