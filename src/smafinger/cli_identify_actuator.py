@@ -121,7 +121,8 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     controller = _controller(gains, duty_max) if replay else None
     runs = [load_open_loop(*_run_map(a, maps), "fit", p, wire=wire) for a in fit]
     runs += [load_open_loop(*_run_map(a, maps), "validate", p, wire=wire) for a in validate]
-    runs += [load_closed_loop(*_run_map(a, maps), p, controller, reference=reference) for a in replay]
+    runs += [load_closed_loop(*_run_map(a, maps), p, controller, reference=reference, offset=offset == "per-run")
+             for a in replay]
     box = FreeBox(p, parse_free(p, free)) if fit else None
     settings = FitSettings(budget=budget, max_nfev=max_nfev, seed=seed, fit_offsets=offset == "per-run")
     base = params if (params in REGISTRY and not overrides) else p

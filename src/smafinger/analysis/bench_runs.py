@@ -256,13 +256,18 @@ def load_open_loop(path, mapping, role: str, p: ParameterSet, wire: str | None =
 
 
 def load_closed_loop(path, mapping, p: ParameterSet, controller: RigController, reference: str | None = None,
-                     dt_s: float = DEFAULT_DT_S) -> BenchRun:
+                     dt_s: float = DEFAULT_DT_S, offset: bool = True) -> BenchRun:
     """A closed-loop run to replay: its reference becomes the target profile of the rig's PID.
 
     ``reference`` is the reference column as ``NAME[*FACTOR]`` (default: ``position_ref_m`` or
     ``theta_ref_deg``), read from the same file with the same checks and units as the output.
     The reference is in the sensor's frame; the target is the reference minus the offset
-    measured on the baseline (the samples before the reference first changes).
+    measured on the baseline (the samples before the reference first changes), or the
+    reference itself with ``offset=False`` (a calibrated sensor).
+
+    A closed loop can amplify small differences: where the PID drives the wire bang-bang
+    through a steep transformation band, a target 1 um off can move a rise by tens of
+    milliseconds (``docs/identification.md``).
     """
     smap = as_signal_map(mapping)
     q = coordinate_column(p)
@@ -276,7 +281,7 @@ def load_closed_loop(path, mapping, p: ParameterSet, controller: RigController, 
     t_ref, v_ref = ref.t_s - t0, ref.values
     moved = np.flatnonzero(v_ref != v_ref[0])
     baseline = _rest_mask(rec.output.t_s, float(t_ref[moved[0]]) if moved.size else math.inf)
-    offset = float(np.mean(samples.values[baseline])) - rest_coordinate_si(p)
+    offset = float(np.mean(samples.values[baseline])) - rest_coordinate_si(p) if offset else 0.0
     run = BenchRun(str(path), "validate", "closed-loop", rec, samples, interval, t_end, baseline,
                    reference=(t_ref, v_ref), controller=controller, reference_offset=offset)
     return replace(run, profile=reference_profile(t_ref, v_ref - offset, p))

@@ -19,6 +19,7 @@ from ..engine.run import simulate
 from ..files import atomic_write
 from ..parameters import ParameterSet
 from ..profiles import TargetProfile, VoltageProgram
+from ..recordings.signals import SPEC
 from .bench_runs import RigController, coordinate_column, reference_column
 
 SIM_OUTPUT_S = 1e-3
@@ -29,7 +30,8 @@ class SyntheticRun:
     """A recorded run: the drive at its times, the measured coordinate (SI) at its times.
 
     ``reference`` (closed loop) is the target as the rig saw it, in the sensor's frame
-    (target + offset), at the output times. ``truth`` records how it was made.
+    (target + offset), at the output times. ``coordinate`` and ``reference_name`` are the file's
+    column names (``theta_deg`` is written in degrees). ``truth`` records how it was made.
     """
 
     t_input_s: np.ndarray
@@ -40,6 +42,11 @@ class SyntheticRun:
     reference: np.ndarray | None = None
     reference_name: str = ""
     truth: dict = field(default_factory=dict)
+
+
+def file_units(name: str, si: np.ndarray) -> np.ndarray:
+    """SI values of the canonical signal ``name`` in the file's units (radians -> degrees)."""
+    return np.asarray(si) / SPEC[name].to_si
 
 
 def _grid(period_s: float, t_end_s: float) -> np.ndarray:
@@ -98,9 +105,10 @@ def write_csv(path, run: SyntheticRun, digits: int = 7) -> None:
     t = np.union1d(run.t_input_s, run.t_output_s)
     df = pd.DataFrame({"t_s": t})
     df["duty"] = pd.Series(run.duty, index=np.searchsorted(t, run.t_input_s))
-    df[run.coordinate] = pd.Series(run.output, index=np.searchsorted(t, run.t_output_s))
+    at_out = np.searchsorted(t, run.t_output_s)
+    df[run.coordinate] = pd.Series(file_units(run.coordinate, run.output), index=at_out)
     if run.reference is not None:
-        df[run.reference_name] = pd.Series(run.reference, index=np.searchsorted(t, run.t_output_s))
+        df[run.reference_name] = pd.Series(file_units(run.coordinate, run.reference), index=at_out)
     atomic_write(path, lambda tmp: df.to_csv(tmp, index=False, float_format=f"%.{digits}g", na_rep=""))
 
 
@@ -108,12 +116,13 @@ def write_simulink_mat(path, run: SyntheticRun, names: dict[str, tuple[str, floa
                        provenance: dict | None = None) -> None:
     """A MATLAB file as Simulink's "To Workspace" blocks (Structure With Time) save it, each
     signal at its own rate. ``names``: signal (``duty``, the coordinate, the reference) ->
-    (variable name, factor from SI to the file's unit), e.g. ``{"position_m": ("x_mm", 1e3)}``."""
+    (variable name, factor from the canonical file unit, e.g. ``{"position_m": ("x_mm", 1e3)}``:
+    millimetres; ``theta_deg`` is in degrees before the factor)."""
     from scipy.io import savemat
 
-    series = {"duty": (run.t_input_s, run.duty), run.coordinate: (run.t_output_s, run.output)}
+    series = {"duty": (run.t_input_s, run.duty), run.coordinate: (run.t_output_s, file_units(run.coordinate, run.output))}
     if run.reference is not None:
-        series[run.reference_name] = (run.t_output_s, run.reference)
+        series[run.reference_name] = (run.t_output_s, file_units(run.coordinate, run.reference))
     mdict = {}
     for sig, (var, factor) in names.items():
         t, v = series[sig]
