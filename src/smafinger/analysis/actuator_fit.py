@@ -136,9 +136,14 @@ def _rms(sse: float, n: int) -> float:
 
 def global_stage(ev: Evaluator, u0: np.ndarray, s: FitSettings,
                  on_generation: Callable[[int, float], None] | None = None) -> tuple[np.ndarray, dict]:
-    """CMA-ES from u0 within [0, 1]^n; the best point seen (u0 if nothing beat it)."""
+    """CMA-ES from u0 within [0, 1]^n; the best point seen (u0 if nothing beat it).
+
+    With one free parameter (CMA-ES needs two) it is a scan of ``budget`` evenly spaced values.
+    """
     import cma
 
+    if len(u0) == 1:
+        return _scan(ev, u0, s)
     f0 = float(ev.sse([u0])[0])
     scale = f0 if f0 > 0 else 1.0  # CMA sees SSE / SSE(start): its tolerances become relative
     opts = {"bounds": [0.0, 1.0], "maxfevals": s.budget, "seed": s.seed, "verbose": -9}
@@ -165,6 +170,16 @@ def global_stage(ev: Evaluator, u0: np.ndarray, s: FitSettings,
     return np.clip(best, 0.0, 1.0), {"stage": "global", "method": "CMA-ES (cma)", "evaluations": evals,
                                      "generations": generation, "rms_before": _rms(f0, n),
                                      "rms_after": _rms(fbest, n), "stop": stop}
+
+
+def _scan(ev: Evaluator, u0: np.ndarray, s: FitSettings) -> tuple[np.ndarray, dict]:
+    points = [np.asarray(u0, dtype=np.float64)] + [np.array([x]) for x in np.linspace(0.0, 1.0, max(s.budget, 2))]
+    f = ev.sse(points)
+    k = int(np.argmin(f))
+    n = ev.n_residuals
+    return points[k], {"stage": "global", "method": "scan (one free parameter)", "evaluations": len(points) - 1,
+                       "generations": 1, "rms_before": _rms(float(f[0]), n), "rms_after": _rms(float(f[k]), n),
+                       "stop": "budget"}
 
 
 def local_stage(ev: Evaluator, u0: np.ndarray, s: FitSettings) -> tuple[np.ndarray, dict]:
