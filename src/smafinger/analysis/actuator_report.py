@@ -132,27 +132,31 @@ def files_report(predictions: Sequence[RunPrediction], p: ParameterSet, figures:
     return rows
 
 
+#: the report's summary groups: name -> (role, mode) of its runs
+SUMMARY_GROUPS = {"fit": ("fit", "open-loop"), "validate": ("validate", "open-loop"),
+                  "replay": ("validate", "closed-loop")}
+
+
 def role_summary(predictions: Sequence[RunPrediction], p: ParameterSet) -> dict:
-    """RMS and largest error over all samples of each role (``fit``, ``validate``), the sensor
-    noise measured on the baselines (pooled) and their ratio: near 1 the runs are predicted to
-    the noise level; well above, the model misses something (or the fit a better minimum)."""
+    """RMS and largest error over all samples of the fitted runs (``fit``), the held-out
+    open-loop runs (``validate``) and the closed-loop replays (``replay``), with the sensor noise
+    measured on their baselines (pooled) and the ratio: near 1 the runs are predicted to the noise
+    level; well above, the model misses something (or the fit a better minimum)."""
     u = unit_suffix(p)
     out = {}
-    for role in ("fit", "validate"):
-        res = [pr.residuals for pr in predictions if pr.run.role == role]
-        if not res:
+    for group, (role, mode) in SUMMARY_GROUPS.items():
+        members = [pr for pr in predictions if (pr.run.role, pr.run.mode) == (role, mode)]
+        if not members:
             continue
-        if any(r is None for r in res):
-            out[role] = {f"rms_{u}": None, f"max_abs_{u}": None, "failed": True}
+        if any(pr.residuals is None for pr in members):
+            out[group] = {f"rms_{u}": None, f"max_abs_{u}": None, "failed": True}
             continue
-        r = np.concatenate(res)
+        r = np.concatenate([pr.residuals for pr in members])
         rms = float(np.sqrt(np.mean(r**2)))
-        noise = [pr.run.baseline_noise() for pr in predictions if pr.run.role == role]
-        noise = [x for x in noise if x is not None]
+        noise = [x for x in (pr.run.baseline_noise() for pr in members) if x is not None]
         pooled = float(np.sqrt(np.mean(np.square(noise)))) if noise else None
-        out[role] = {f"rms_{u}": rms, f"max_abs_{u}": float(np.max(np.abs(r))), "n_runs": len(res),
-                     "n_samples": int(r.size), f"noise_{u}": pooled,
-                     "rms_over_noise": rms / pooled if pooled else None}
+        out[group] = {f"rms_{u}": rms, f"max_abs_{u}": float(np.max(np.abs(r))), "n_runs": len(members),
+                      "n_samples": int(r.size), f"noise_{u}": pooled, "rms_over_noise": rms / pooled if pooled else None}
     return out
 
 

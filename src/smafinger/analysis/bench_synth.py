@@ -88,7 +88,7 @@ def closed_loop_run(p: ParameterSet, profile: str, controller: RigController, t_
     r = simulate(controller.apply(p), "cooperative", profile=prof, t_end_s=t_end_s, output_interval_s=SIM_OUTPUT_S)
     t_in, i_in, t_out, measured = _logged(r, p, t_end_s, input_period_s, output_period_s, noise, offset, seed)
     wire = p.wire_names[0]
-    duty = np.round(r.signal(f"duty_{wire}")[i_in] / 100.0 * controller.duty_max, 6)
+    duty = np.round(r.signal(f"duty_{wire}")[i_in] / 100.0 * controller.duty_max, 4)  # a 0.01 % PWM resolution
     i_out = np.round(t_out / SIM_OUTPUT_S).astype(int)
     ref = r.signal(reference_column(p))[i_out] / p.coordinate.scale + offset
     truth = {"mode": "closed-loop", "profile": prof.to_text(), "noise": noise, "offset": offset, "seed": seed,
