@@ -62,6 +62,7 @@ def refused(result, text):
     (["--replay", "{d}/a.csv", "--gains", "1:2"], "expected three numbers"),
     (["--replay", "{d}/a.csv", "--duty-max", "0"], "duty_max = 0.0"),
     (["--replay", "{d}/a.csv"], "no column 'position_ref_m'"),
+    (["--fit", "{d}/a.csv", "--gains", "1:2:3"], "--gains is for closed-loop runs"),
     (["--fit", "{d}/a.csv", "--set", "eps_R=2"], "eps_R = 2.0 is outside"),
     (["--fit", "{d}/a.csv", "--wire", "upper"], "wire 'upper' is not a wire"),
 ])
@@ -103,3 +104,13 @@ def test_the_fit_is_the_same_in_this_process_and_in_two_workers(files):
             fits.append(fit_actuator([run], box, pool, settings))
     assert fits[0].values == fits[1].values and fits[0].stderr == fits[1].stderr
     assert fits[0].offsets == fits[1].offsets and fits[0].n_simulations == fits[1].n_simulations
+
+
+def test_the_command_mounts_under_identify(files):
+    identify = typer.Typer()
+    identify.command("actuator")(actuator)
+    root = typer.Typer()
+    root.command("other")(lambda: None)
+    root.add_typer(identify, name="identify")
+    r = CliRunner().invoke(root, ["identify", "actuator", "--help"])
+    assert r.exit_code == 0 and "--replay" in r.output and "--free" in r.output

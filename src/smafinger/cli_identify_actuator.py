@@ -108,6 +108,10 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
             raise Usage(f"{opt} {value}: must be >= {lo}")
     if not fit and (free or out is not None):
         raise Usage(f"{'--free' if free else '--out'} needs runs to fit (--fit RUN)")
+    replay_only = [o for o, given in (("--gains", gains is not None), ("--duty-max", duty_max != 1.0),
+                                      ("--reference", reference is not None)) if given]
+    if replay_only and not replay:
+        raise Usage(f"{replay_only[0]} is for closed-loop runs: give them with --replay RUN")
     _check_path("--out", out, (".toml",))
     _check_path("--report", report, (".json",))
     if plot is not None and (plot.exists() and not plot.is_dir() or not plot.parent.exists()):

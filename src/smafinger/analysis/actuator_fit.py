@@ -99,7 +99,7 @@ class ActuatorFit:
     stderr_white: dict[str, float]
     correlation: list[list[float]]
     offsets: dict[str, float]
-    offset_stderr: dict[str, float]
+    offset_stderr: dict[str, float | None]
     rho: dict[str, float]
     rms_start: float
     rms: float
@@ -281,7 +281,7 @@ def fit_actuator(runs: Sequence[BenchRun], box: FreeBox, pool, settings: FitSett
         stderr=dict(zip(names, se[:n].tolist())), stderr_white=dict(zip(names, se_w[:n].tolist())),
         correlation=cov.correlation()[:n, :n].tolist(),
         offsets=dict(zip(files, offsets.tolist())),
-        offset_stderr=dict(zip(files, se[n:].tolist())) if settings.fit_offsets else {f: 0.0 for f in files},
+        offset_stderr=dict(zip(files, se[n:].tolist())) if settings.fit_offsets else {f: None for f in files},
         rho=dict(zip(files, cov.rho.tolist())), rms_start=_rms(start_eval.sse, ev.n_residuals),
         rms=_rms(final.sse, ev.n_residuals), at_bounds=box.at_bounds(u), stages=stages,
         n_simulations=ev.n_sims, wall_s=time.perf_counter() - t0, rank_deficient=cov.rank_deficient,

@@ -111,7 +111,8 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
     return out
 
 
-def files_report(predictions: Sequence[RunPrediction], p: ParameterSet, figures: dict[str, str] | None = None) -> list[dict]:
+def files_report(predictions: Sequence[RunPrediction], p: ParameterSet,
+                 figures: dict[str, str] | None = None) -> list[dict]:
     """The report's ``files``: per run its file, role, mode, errors, offset and figure."""
     u = unit_suffix(p)
     figures = figures or {}
@@ -156,7 +157,8 @@ def role_summary(predictions: Sequence[RunPrediction], p: ParameterSet) -> dict:
         noise = [x for x in (pr.run.baseline_noise() for pr in members) if x is not None]
         pooled = float(np.sqrt(np.mean(np.square(noise)))) if noise else None
         out[group] = {f"rms_{u}": rms, f"max_abs_{u}": float(np.max(np.abs(r))), "n_runs": len(members),
-                      "n_samples": int(r.size), f"noise_{u}": pooled, "rms_over_noise": rms / pooled if pooled else None}
+                      "n_samples": int(r.size), f"noise_{u}": pooled,
+                      "rms_over_noise": rms / pooled if pooled else None}
     return out
 
 

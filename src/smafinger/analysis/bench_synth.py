@@ -120,7 +120,8 @@ def write_simulink_mat(path, run: SyntheticRun, names: dict[str, tuple[str, floa
     millimetres; ``theta_deg`` is in degrees before the factor)."""
     from scipy.io import savemat
 
-    series = {"duty": (run.t_input_s, run.duty), run.coordinate: (run.t_output_s, file_units(run.coordinate, run.output))}
+    series = {"duty": (run.t_input_s, run.duty),
+              run.coordinate: (run.t_output_s, file_units(run.coordinate, run.output))}
     if run.reference is not None:
         series[run.reference_name] = (run.t_output_s, file_units(run.coordinate, run.reference))
     mdict = {}
