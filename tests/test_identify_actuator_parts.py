@@ -16,6 +16,7 @@ from smafinger.analysis.bench_runs import (BenchRunError, RigController, drive_p
 from smafinger.analysis.fit_uncertainty import ar1_times, covariance, lag1_autocorrelation
 from smafinger.analysis.free_params import (DEFAULT_FREE, MIN_GAP_C, FreeBox, FreeParameterError, make_free,
                                             parse_free)
+from smafinger.model.build import build_model
 from smafinger.parameters import get
 from smafinger.recordings import RecordingError
 
@@ -38,11 +39,13 @@ def test_default_free_parameters_contain_the_start(p):
 
 
 @settings(max_examples=60, deadline=None)
-@given(st.lists(st.floats(0.0, 1.0), min_size=8, max_size=8))
-def test_every_point_of_the_box_is_a_valid_ordered_set_within_the_bounds(u):
-    box = FreeBox(LINEAR, parse_free(LINEAR, None))
-    p = box.params(u)  # a refused set would raise
-    assert p.A_F0_C >= p.A_S0_C + MIN_GAP_C - 1e-9 and p.M_S0_C >= p.M_F0_C + MIN_GAP_C - 1e-9
+@given(st.sampled_from([LINEAR, JOINT]), st.lists(st.floats(0.0, 1.0), min_size=9, max_size=9))
+def test_every_point_of_the_box_is_a_valid_ordered_set_within_the_bounds(p, u):
+    box = FreeBox(p, parse_free(p, None))
+    u = u[:box.n]
+    q = box.params(u)  # a refused set would raise
+    build_model(q)  # and so would one the engine cannot start from
+    assert q.A_F0_C >= q.A_S0_C + MIN_GAP_C - 1e-9 and q.M_S0_C >= q.M_F0_C + MIN_GAP_C - 1e-9
     values = box.values(u)
     for f in box.free:
         assert f.lo - 1e-9 <= values[f.name] <= f.hi + 1e-9
