@@ -1,0 +1,133 @@
+"""``identify actuator``: refusals (one line, exit 2, nothing written), the joint's angle, and
+the same fit whether it runs in this process or in worker processes."""
+
+import json
+
+import pytest
+import typer
+from typer.testing import CliRunner
+
+from smafinger.analysis import bench_synth as bs
+from smafinger.analysis.actuator_fit import FitSettings, fit_actuator
+from smafinger.analysis.bench_runs import load_open_loop
+from smafinger.analysis.free_params import FreeBox, parse_free
+from smafinger.cli_identify_actuator import actuator
+from smafinger.engine.batch import make_pool
+from smafinger.parameters import get
+
+LINEAR = get("linear-bias-spring")
+JOINT = get("paper2010")
+
+
+def invoke(*args):
+    app = typer.Typer()
+    app.command()(actuator)
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("runs")
+    truth = LINEAR.replace(A_S0_C=71.0)
+    bs.write_csv(d / "a.csv", bs.open_loop_run(truth, "0:0,0.2:0.5,2:0", 4.0, noise=2e-5, offset=1e-3, seed=1))
+    bs.write_csv(d / "joint.csv", bs.open_loop_run(JOINT, "0:0:0,0.2:0.6:0", 1.0, seed=2))
+    (d / "notes.txt").write_text("not a run\n")
+    return d
+
+
+def refused(result, text):
+    assert result.exit_code == 2, result.output
+    lines = [ln for ln in result.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("smafinger identify actuator: error: "), result.output
+    assert text in lines[0], lines[0]
+
+
+@pytest.mark.parametrize("args, text", [
+    ([], "no run given"),
+    (["--fit", "{d}/missing.csv"], "missing.csv: file not found"),
+    (["--fit", "{d}/notes.txt"], "unknown format '.txt'"),
+    (["--fit", "{d}/joint.csv"], "the output is theta_rad but a linear-bias-spring set"),
+    (["--fit", "{d}/a.csv", "--validate", "{d}/a.csv"], "given twice"),
+    (["--fit", "{d}/a.csv", "--map", "duty=u*abc"], "'abc' after '*'"),
+    (["--fit", "{d}/a.csv::duty=u_pwm"], "mapping duty=u_pwm: no column 'u_pwm'"),
+    (["--fit", "{d}/a.csv", "--free", "A_S0_C:90:95"], "start value 68"),
+    (["--fit", "{d}/a.csv", "--free", "wire_mass"], "'wire_mass' is not a numeric parameter"),
+    (["--validate", "{d}/a.csv", "--free", "A_S0_C"], "--free needs runs to fit"),
+    (["--validate", "{d}/a.csv", "--out", "{d}/fit.toml"], "--out needs runs to fit"),
+    (["--fit", "{d}/a.csv", "--out", "{d}/fit.txt"], "must end in .toml"),
+    (["--fit", "{d}/a.csv", "--report", "{d}/nodir/r.json"], "does not exist"),
+    (["--fit", "{d}/a.csv", "--plot", "{d}/a.csv"], "--plot"),
+    (["--fit", "{d}/a.csv", "--offset", "mean"], "--offset 'mean'"),
+    (["--fit", "{d}/a.csv", "--budget", "-1"], "--budget -1"),
+    (["--replay", "{d}/a.csv", "--gains", "1:2"], "expected three numbers"),
+    (["--replay", "{d}/a.csv", "--duty-max", "0"], "duty_max = 0.0"),
+    (["--replay", "{d}/a.csv"], "no column 'position_ref_m'"),
+    (["--fit", "{d}/a.csv", "--gains", "1:2:3"], "--gains is for closed-loop runs"),
+    (["--fit", "{d}/a.csv", "--set", "eps_R=2"], "eps_R = 2.0 is outside"),
+    (["--fit", "{d}/a.csv", "--wire", "upper"], "wire 'upper' is not a wire"),
+])
+def test_refusals_are_one_line_with_status_2_and_write_nothing(files, args, text):
+    before = sorted(p.name for p in files.iterdir())
+    r = invoke("--params", "linear-bias-spring", *[a.format(d=files) for a in args], "--workers", "1")
+    refused(r, text)
+    assert sorted(p.name for p in files.iterdir()) == before
+
+
+def test_the_joint_angle_is_fitted_and_reported_in_radians(tmp_path):
+    truth = JOINT.replace(h0_heating_W_m2K=26.0)
+    run = bs.open_loop_run(truth, "0:0:0,0.2:1:0,5:0:0", 8.0, noise=0.01 * 3.14159 / 180, offset=0.01, seed=5)
+    bs.write_csv(tmp_path / "heat.csv", run)
+    r = invoke("--params", "paper2010", "--fit", tmp_path / "heat.csv", "--free", "h0_heating_W_m2K",
+               "--budget", "12", "--max-nfev", "8", "--workers", "1", "--report", tmp_path / "j.json",
+               "--out", tmp_path / "j.toml")
+    assert r.exit_code == 0, r.output
+    rep = json.loads((tmp_path / "j.json").read_text())
+    assert rep["unit"] == "rad" and rep["output"] == "theta_rad"
+    f = rep["files"][0]
+    assert {"rms_rad", "max_abs_rad", "offset_rad"} <= set(f) and f["rms_rad"] < 2e-4
+    assert f["offset_rad"] == pytest.approx(0.01, abs=2e-4)
+    h0, se = rep["fit"]["values"]["h0_heating_W_m2K"], rep["fit"]["stderr"]["h0_heating_W_m2K"]
+    assert 0 < se < 0.5 and abs(h0 - 26.0) < 3 * se  # from the set's 20
+    assert "deg" in r.output  # the console speaks degrees
+
+
+def test_the_fit_is_the_same_in_this_process_and_in_two_workers(files):
+    """The batch engine is deterministic and CMA-ES is seeded: the fit is bit-identical however
+    its simulations are spread."""
+    p = LINEAR
+    run = load_open_loop(files / "a.csv", None, "fit", p)
+    settings = FitSettings(budget=16, popsize=8, max_nfev=4)
+    fits = []
+    for workers in (1, 2):
+        box = FreeBox(p, parse_free(p, ["A_S0_C", "h0_heating_W_m2K"]))
+        with make_pool(workers) as pool:
+            fits.append(fit_actuator([run], box, pool, settings))
+    assert fits[0].values == fits[1].values and fits[0].stderr == fits[1].stderr
+    assert fits[0].offsets == fits[1].offsets and fits[0].n_simulations == fits[1].n_simulations
+
+
+def test_the_command_mounts_under_identify(files):
+    identify = typer.Typer()
+    identify.command("actuator")(actuator)
+    root = typer.Typer()
+    root.command("other")(lambda: None)
+    root.add_typer(identify, name="identify")
+    r = CliRunner().invoke(root, ["identify", "actuator", "--help"])
+    assert r.exit_code == 0 and "--replay" in r.output and "--free" in r.output
+
+
+def test_a_closed_loop_joint_run_replays_in_degrees_and_radians(tmp_path):
+    """The joint's reference is an angle in degrees in the file (theta_ref_deg), the gains are in
+    duty per radian: with the set that made the run and exact targets the replay matches."""
+    from smafinger.analysis.bench_runs import RigController
+
+    rig = RigController(K_P=30.0, K_V=30.0, K_I=0.5)  # the paper's gains, in duty per rad
+    run = bs.closed_loop_run(JOINT, "0:-40,0.5:-30", rig, 6.0, noise=1e-4, seed=9)
+    bs.write_csv(tmp_path / "track.csv", run)
+    assert "theta_ref_deg" in (tmp_path / "track.csv").read_text().splitlines()[0]
+    r = invoke("--params", "paper2010", "--replay", tmp_path / "track.csv", "--gains", "30:30:0.5",
+               "--offset", "none", "--workers", "1", "--report", tmp_path / "r.json")
+    assert r.exit_code == 0, r.output
+    f = json.loads((tmp_path / "r.json").read_text())["files"][0]
+    assert f["mode"] == "closed-loop" and f["rms_rad"] < 1.2e-4
+    assert max(run.output) - min(run.output) > 0.1  # it moved by more than 6 deg
