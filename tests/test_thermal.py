@@ -57,13 +57,13 @@ def test_latent_heat_balance_through_a_transformation():
     p = get("paper2010").replace(latent_heat_J_kg=dH, h0_heating_W_m2K=0.0, h2_heating_W_m2K3=0.0,
                                  h0_cooling_W_m2K=0.0, h2_cooling_W_m2K3=0.0)
     _, M_w, _ = wire_constants(p)
-    V = 3.0
-    r = simulate(p, "open-loop", voltage=f"0:{V}:0", t_end_s=8.0, dt_s=1e-4)
+    V = 6.0
+    r = simulate(p, "open-loop", voltage=f"0:{V}:0", t_end_s=10.0, dt_s=1e-4)
     assert r.xi_upper[-1] < 0.2  # most of the wire transformed
     t, T, xi = r.t, r.T_upper_C, r.xi_upper
     heat_in = V**2 / p.resistance_ohm_per_m * t
     stored = M_w * p.specific_heat_J_kgK * (T - T[0]) + M_w * dH * (xi[0] - xi)
     assert np.max(np.abs(heat_in - stored)) < 1e-6 * heat_in[-1]
     # without the latent heat the same power heats the wire faster through the band
-    plain = simulate(p.replace(latent_heat_J_kg=0.0), "open-loop", voltage=f"0:{V}:0", t_end_s=8.0, dt_s=1e-4)
+    plain = simulate(p.replace(latent_heat_J_kg=0.0), "open-loop", voltage=f"0:{V}:0", t_end_s=10.0, dt_s=1e-4)
     assert plain.T_upper_C[-1] > T[-1] + 5.0

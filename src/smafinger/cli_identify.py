@@ -333,3 +333,9 @@ def _jsonable(x):
     except (TypeError, ValueError):
         return str(x)
     return v if math.isfinite(v) else None
+
+
+# identify actuator (issue 12): fit a bench actuator to recorded runs, predict held-out ones
+from .cli_identify_actuator import actuator as _actuator  # noqa: E402
+
+app.command("actuator")(_actuator)
