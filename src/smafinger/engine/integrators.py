@@ -75,6 +75,6 @@ def step(method, model, y, h, inputs, k1, geom):
         yk = axpy(y, h if stage == 2 else half, k)
         g = geometry_at(yk.q, q_prev, g, model)
         q_prev = yk.q
-        k = derivative(yk, inputs, model, g)[0]
+        k, _ = derivative(yk, inputs, model, g)
         acc = axpy(acc, 1.0 if stage == 2 else 2.0, k)
     return axpy(y, h / 6.0, acc), 3

@@ -14,7 +14,7 @@ from numba import njit
 
 from ..model.dynamics import angular_acceleration, external_load, wire_load
 from ..model.heat import electrical_power, joule_power_per_m
-from ..model.kinematics import route
+from ..model.kinematics import WireGeometry, route
 from ..model.records import Aux, State, WireAux, WireState
 from ..model.wire import wire_rates
 from .tuples import filled, set_item
@@ -23,7 +23,7 @@ from .tuples import filled, set_item
 class Geometry(NamedTuple):
     """Everything that depends on q alone: reused while q does not change (a stuck mechanism)."""
 
-    routes: tuple  #: per wire: (path [m], d path / d q, arm)
+    routes: tuple  #: per wire: model.kinematics.WireGeometry
     cos_q: float
     external: float  #: the mechanism's load apart from the wires (gravity, bias spring)
 
@@ -32,7 +32,7 @@ class Geometry(NamedTuple):
 def geometry(model, q):
     """:class:`Geometry` at coordinate q (Eqs. 3-6 and the external load of Eq. 1b)."""
     w = model.wires
-    routes = filled(w, (0.0, 0.0, 0.0))
+    routes = filled(w, WireGeometry(0.0, 0.0, 0.0))
     for i in range(len(w)):
         routes = set_item(routes, i, route(w[i].route, q))
     c = math.cos(q)
@@ -57,8 +57,8 @@ def _wire_terms(model, state, inputs, geom, i):
     dT, dsigma, dTc, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, opts)
     heat = joule_power_per_m(wire, wi.drive, inputs.current_drive, opts.joule_heating) * wire.wire_length_m
     rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive), heat, dTc)
-    aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt[2], dT)
-    return rate, aux, wire_load(sigma, wire.area_m2, rt[1])
+    aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt.arm_m, dT)
+    return rate, aux, wire_load(sigma, wire.area_m2, rt.dpath_dq)
 
 
 @njit(cache=True, inline="always")

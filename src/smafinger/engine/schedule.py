@@ -42,8 +42,9 @@ def initial_schedule(q0: float) -> Schedule:
 @njit(cache=True)
 def _xi(model, state, inputs, geom, i):
     """xi of wire i at the state, on its current branch."""
-    return wire_stress_xi(model.wires[i], state.wires[i], inputs.wires[i].branch, geom.routes[i][0],
-                          model.options.stress_law)[1]
+    _, xi = wire_stress_xi(model.wires[i], state.wires[i], inputs.wires[i].branch, geom.routes[i].path_m,
+                           model.options.stress_law)
+    return xi
 
 
 @njit(cache=True)

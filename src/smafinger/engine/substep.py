@@ -46,9 +46,11 @@ def initial_state(model):
 def _initial_branch(wire, rule):
     """A wire at rest on its kinetics branch (model.hysteresis), with the rule's dead band."""
     if rule == Hysteresis.DEADBAND:
-        return initial_record(DEADBAND, wire.xi_init, wire.T_init_C, wire.minor_loop_reversal_C)[0]
+        rec, _ = initial_record(DEADBAND, wire.xi_init, wire.T_init_C, wire.minor_loop_reversal_C)
+        return rec
     code = AUTHORS2020 if rule == Hysteresis.AUTHORS2020 else MEMORY
-    return initial_record(code, wire.xi_init, wire.T_init_C, 0.0)[0]
+    rec, _ = initial_record(code, wire.xi_init, wire.T_init_C, 0.0)
+    return rec
 
 
 @njit(cache=True)

@@ -64,7 +64,7 @@ def initial_spring_elongations(p: JointParameters) -> tuple[float, float]:
         return p.spring_length_upper_m - p.spring_free_length_m, x_l
     th0 = math.radians(p.theta0_deg)
     upper, lower = tendon_routes(p)
-    b_u, b_l = wire_route(upper, th0)[2], wire_route(lower, th0)[2]
+    b_u, b_l = wire_route(upper, th0).arm_m, wire_route(lower, th0).arm_m
     F_l = p.spring_K_N_m * x_l
     F_u = (F_l * b_l + p.mass_kg * p.gravity_m_s2 * p.d_CM_m * math.cos(th0)) / b_u
     if F_u <= 0.0:
@@ -86,7 +86,7 @@ def _joint(p: JointParameters):
             p, direction=direction, series_rigid=False, series_K_N_m=p.spring_K_N_m,
             series_limit_m=x0 + p.slack_m - p.slack_band_m, series_penalty_per_mm=p.slack_penalty_per_mm,
             series_x0_m=x0, sigma0_Pa=p.spring_K_N_m * x0 / S_w, eps_total0=eps_el0 + p.eps_R * p.xi_init,
-            path0_m=wire_route(rt, th0)[0], route=rt))
+            path0_m=wire_route(rt, th0).path_m, route=rt))
     dynamics = Dynamics(
         inertia=p.inertia_kg_m2, q0=th0, static_friction=p.M_SF_Nm, dynamic_friction=p.M_DF_Nm,
         viscous_heating=p.C_DF_heating_Nms, viscous_cooling=p.C_DF_cooling_Nms,

@@ -39,6 +39,14 @@ class TendonRoute(NamedTuple):
     wrapped_when_up: bool  #: the lower tendon wraps over D while the finger is up, the upper while down
 
 
+class WireGeometry(NamedTuple):
+    """Where a wire meets the mechanism at coordinate q (what :func:`route` returns)."""
+
+    path_m: float  #: path length (Eq. 6 takes its change)
+    dpath_dq: float  #: d path / d q (m/rad or m/m)
+    arm_m: float  #: moment arm b (Eqs. 4b, 5b); 1 for a slider
+
+
 class DirectPull(NamedTuple):
     """A wire pulling a slider along its axis."""
 
@@ -47,7 +55,7 @@ class DirectPull(NamedTuple):
 
 @njit(cache=True, inline="always")
 def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
-    """Path length [m], d(path)/d(theta) [m/rad] and moment arm b [m] of one tendon.
+    """:class:`WireGeometry` of one tendon: path length [m], d(path)/d(theta) [m/rad], moment arm b [m].
 
     Eqs. (3), (4a)/(5a) without the reference subtraction, (4b)/(5b).
     """
@@ -66,7 +74,7 @@ def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     # d|PB|/dtheta with dB/dtheta = (-yb, xb)
     dpath = (xp * yb - yp * xb) / dpb
     arm = abs(xb * yp - xp * yb) / dpb
-    return fixed + dpb, dpath, arm
+    return WireGeometry(fixed + dpb, dpath, arm)
 
 
 @njit(cache=True, inline="always")
@@ -80,11 +88,11 @@ def tendon_route(rt, theta):
 @njit(cache=True, inline="always")
 def direct_pull(rt, x):
     """(path, dpath/dx, arm) of a wire pulling a slider: path = -x from the start."""
-    return rt.dpath_dq * x, rt.dpath_dq, 1.0
+    return WireGeometry(rt.dpath_dq * x, rt.dpath_dq, 1.0)
 
 
 def route(rt, q):
-    """(path [m], d path / d q, arm) of a wire at coordinate q; dispatched on the route's type."""
+    """The :class:`WireGeometry` of a wire at coordinate q; dispatched on the route's type."""
     raise NotImplementedError("route() is compiled code: call it from a numba function")
 
 

@@ -99,12 +99,13 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
 def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
     """A wire's (dT/dt, dsigma/dt, dT_case/dt) and (sigma, xi, spring elongation).
 
-    ``route_now`` = (path, dpath/dq, arm) at the current q; ``wi`` the wire's held inputs.
+    ``route_now``: the wire's :class:`~smafinger.model.kinematics.WireGeometry` at the current q;
+    ``wi`` the wire's held inputs.
     Rate law: dsigma/dt of Eq. (7b) with dxi/dt = xi_T T' + xi_sigma sigma'; with the latent heat
     on, T' and sigma' are solved together. Algebraic law: sigma solved with xi; the latent heat
     then takes dxi/dt = xi_T T' (sigma's own rate is not part of the state).
     """
-    path, dpath, _ = route_now
+    path, dpath = route_now.path_m, route_now.dpath_dq
     T = ws.T_C
     dT0 = wire_temperature_rate(wire, T, ws.T_case_C, wi.drive, wi.heating, current_drive, opts)
     dTc = casing_temperature_rate(wire, T, ws.T_case_C, wi.heating, opts)
