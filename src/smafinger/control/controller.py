@@ -44,7 +44,10 @@ def program_commands(cmds, levels, duties):
 
 @njit(cache=True, inline="always")
 def viscous_coefficient(dynamics, cmds, rule):
-    """C_DF: the heating value while any wire heats (or is enabled, per ``rule``), else cooling."""
+    """C_DF: the heating value while any wire heats (or is enabled, per ``rule``; always with
+    ``heating-value``), else the cooling value."""
+    if rule == DampingSwitch.HEATING_VALUE:
+        return dynamics.viscous_heating
     hot = False
     for i in range(len(cmds)):
         if (cmds[i].enabled if rule == DampingSwitch.ENABLED else cmds[i].heating):
