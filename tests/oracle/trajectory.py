@@ -172,7 +172,7 @@ def commit(seg: _Segment, y, forced: dict[int, int] | None = None) -> None:
 def on_event(name: str, seg: _Segment, y) -> dict[int, int]:
     """Apply the event ``name`` to the discrete state ``seg.hy`` and the state vector y.
 
-    Returns the wires whose driving rate turned (for :func:`commit`).
+    Returns the wires whose driving rate turned or started, with their new sign (for :func:`commit`).
     """
     hy, mc, d = seg.hy, seg.m.mechanism, seg.at(None, y)
     load = d.outputs["load"]
