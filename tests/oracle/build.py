@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from smafinger.parameters import JointParameters, LinearActuatorParameters, ParameterSet
-from smafinger.parameters.options import DampingSwitch, FrictionSticking, JouleHeating, SpringInit, StressLaw
+from smafinger.parameters.options import FrictionSticking, Hysteresis, JouleHeating, SpringInit, StressLaw, ThermalModel
 
 from . import material as mat
 from .model import Joint, OracleModel, Slider, Wire
@@ -22,9 +22,9 @@ def build(p: ParameterSet) -> OracleModel:
     o = p.options
     return OracleModel(
         mechanism, tuple(wires), algebraic=o.stress_law is StressLaw.ALGEBRAIC,
-        whole_wire=o.joule_heating is JouleHeating.WHOLE_WIRE,
-        restick=o.friction_sticking is FrictionSticking.RESTICK,
-        damping_by_enable=o.damping_switch is DampingSwitch.ENABLED,
+        whole_wire=o.joule_heating is JouleHeating.WHOLE_WIRE, two_node=o.thermal_model is ThermalModel.TWO_NODE,
+        restick=o.friction_sticking is FrictionSticking.RESTICK, damping=o.damping_switch.label,
+        rule=o.hysteresis.label, reversal=p.minor_loop_reversal_C if o.hysteresis is Hysteresis.DEADBAND else 0.0,
         V_H=p.V_H_V, V_L=p.V_L_V, pwm_period=p.pwm_period_s, initial_target=p.to_si(p.initial_target))
 
 
@@ -37,7 +37,8 @@ def _wire(p: ParameterSet, name: str, spring, sigma0: float, elastic_elongation0
         transformation=mat.Transformation(p.A_S0_C, p.A_F0_C, p.M_S0_C, p.M_F0_C, p.c_A_Pa_per_C, p.c_M_Pa_per_C),
         D_A=p.D_A_Pa, D_M=p.D_M_Pa, eps_R=p.eps_R, spring=spring, sigma0=sigma0,
         eps0=elastic_elongation0 / p.wire_length_m + p.eps_R * p.xi_init, path0=path0,
-        xi_init=p.xi_init, T_init=p.T_init_C)
+        xi_init=p.xi_init, T_init=p.T_init_C, latent_heat=p.latent_heat_J_kg,
+        casing_capacity=p.casing_heat_capacity_J_mK, casing_loss=p.casing_loss_W_mK)
 
 
 def _wire_elongation(p: ParameterSet, sigma: float) -> float:

@@ -1,4 +1,4 @@
-"""Eqs. (7)-(10) in plain Python: moduli, the spring-slack tendon, phase kinetics, stress laws.
+"""Eqs. (7)-(10) in plain Python: moduli, the spring-slack tendon, the major kinetics curves, stress laws.
 
 Written from the paper and ``shared/MODEL-NOTES.md``, not from ``smafinger.model``; the
 nonlinear equations are solved with :func:`scipy.optimize.brentq`.
@@ -8,26 +8,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import Enum
 
 from scipy.optimize import brentq
-
-
-class Phase(Enum):
-    """Which kinetics curve a wire follows (MODEL-NOTES: the sign of dT/dt)."""
-
-    HOLD = "hold"  #: dT/dt = 0: xi stays where it is
-    HEATING = "heating"  #: Eq. (9), martensite -> austenite, start value xi_M0
-    COOLING = "cooling"  #: Eq. (10), austenite -> martensite, start value xi_A0
-
-
-@dataclass(frozen=True)
-class Kinetics:
-    """Where a wire's xi comes from over a stretch of time: its curve and that curve's start value."""
-
-    phase: Phase
-    start: float  #: xi_M0 (heating) or xi_A0 (cooling)
-    held: float  #: xi while holding
 
 
 @dataclass(frozen=True)
@@ -88,59 +70,6 @@ def cooling_curve(T: float, sigma: float, m: Transformation) -> tuple[float, flo
     return 0.5 * (math.cos(arg) + 1.0), -0.5 * a * s, -0.5 * b * s
 
 
-def martensite_fraction(k: Kinetics, T: float, sigma: float, m: Transformation) -> tuple[float, float, float]:
-    """(xi, dxi/dT, dxi/dsigma) on the kinetics ``k``; xi kept in [0, 1] (flat where clipped)."""
-    if k.phase is Phase.HOLD:
-        return k.held, 0.0, 0.0
-    if k.phase is Phase.HEATING:
-        g, gT, gs = heating_curve(T, sigma, m)
-        xi, xT, xs = k.start * g, k.start * gT, k.start * gs
-    else:
-        g, gT, gs = cooling_curve(T, sigma, m)
-        xi, xT, xs = k.start + (1.0 - k.start) * g, (1.0 - k.start) * gT, (1.0 - k.start) * gs
-    if xi < 0.0:
-        return 0.0, 0.0, 0.0
-    if xi > 1.0:
-        return 1.0, 0.0, 0.0
-    return xi, xT, xs
-
-
-def partial_amplitudes(k: Kinetics, T: float, sigma: float, m: Transformation) -> tuple[float, float]:
-    """Largest |dxi/dT| and |dxi/dsigma| of the curve ``k`` follows, 0 outside its band.
-
-    Inside a band the partials are a sine of an argument that has round-off of its own: near
-    the band's ends, where the sine is small, their round-off is that of these amplitudes.
-    """
-    if k.phase is Phase.HOLD:
-        return 0.0, 0.0
-    if k.phase is Phase.HEATING:
-        g, gT, _ = heating_curve(T, sigma, m)
-        amp, width, c = abs(k.start), m.A_F0 - m.A_S0, m.c_A
-    else:
-        g, gT, _ = cooling_curve(T, sigma, m)
-        amp, width, c = abs(1.0 - k.start), m.M_S0 - m.M_F0, m.c_M
-    if gT == 0.0 and g in (0.0, 1.0):
-        return 0.0, 0.0
-    a = 0.5 * math.pi / width * amp
-    return a, a / c
-
-
-def start_through(phase: Phase, xi: float, T: float, sigma: float, m: Transformation) -> float:
-    """The start value that puts the curve of ``phase`` through xi at (T, sigma) (minor loops).
-
-    MODEL-NOTES: the authors' model re-solves the start value at every reversal so that xi is
-    continuous. Where the curve no longer depends on its start (above A_F on heating, below
-    M_F on cooling) the major loop's value is taken (1, respectively 0).
-    """
-    if phase is Phase.HEATING:
-        g = heating_curve(T, sigma, m)[0]
-        return xi / g if g > 1e-12 else 1.0
-    if phase is Phase.COOLING:
-        g = cooling_curve(T, sigma, m)[0]
-        return (xi - g) / (1.0 - g) if 1.0 - g > 1e-12 else 0.0
-    return xi
-
-
 # --------------------------------------------------------------------------------------------
 # Eqs. (7)-(8): moduli and the spring-slack tendon
 # --------------------------------------------------------------------------------------------
@@ -153,6 +82,12 @@ def spring_stiffness(x: float, s: SpringSlack) -> float:
     """K_s,eff = K_S + cosh(f dx) - 1 [N/m], dx = 1000 (x - knee) in mm, K_S below the knee."""
     dx_mm = (x - s.knee) * 1e3
     return s.K if dx_mm <= 0.0 else s.K + math.cosh(s.per_mm * dx_mm) - 1.0
+
+
+def spring_stiffness_slope(x: float, s: SpringSlack) -> float:
+    """dK_s,eff/dx [N/m^2]: 1000 f sinh(f dx) beyond the knee, 0 below it."""
+    dx_mm = (x - s.knee) * 1e3
+    return 0.0 if dx_mm <= 0.0 else 1e3 * s.per_mm * math.sinh(s.per_mm * dx_mm)
 
 
 def spring_force(x: float, s: SpringSlack) -> float:
@@ -186,17 +121,16 @@ def series_modulus(K_s: float, D: float, S_w: float, L_w: float) -> float:
 # --------------------------------------------------------------------------------------------
 # the two stress laws
 # --------------------------------------------------------------------------------------------
-def stress_rate(D_eq: float, strain_rate: float, eps_R: float, xi_T: float, xi_s: float, T_rate: float,
-                sigma: float) -> float:
-    """dsigma/dt of Eq. (7b) with theta_T = 0: sigma' = D_eq (eps' - eps_R xi').
+def rate_law(D_eq: float, strain_rate: float, eps_R: float, xi_T: float, xi_s: float) -> tuple[float, float]:
+    """Eq. (7b) with theta_T = 0 as sigma' = s_free + s_T T': returns (s_free, s_T).
 
     Eq. (7b) with eps_t = xi eps_R and Omega = -eps_R D: D eps_t' + Omega xi' = 0, so
     sigma' = D_eq (eps_e' + eps_s') = D_eq (eps' - eps_R xi'), and xi' = xi_T T' + xi_s sigma'
-    along the kinetics curve; solved for sigma'. A slack tendon does not push: at sigma <= 0
-    the stress does not decrease further.
+    along the kinetics branch; solved for sigma'. (A slack tendon does not push: the caller
+    floors the rate at sigma <= 0.)
     """
-    rate = D_eq * (strain_rate - eps_R * xi_T * T_rate) / (1.0 + D_eq * eps_R * xi_s)
-    return 0.0 if sigma <= 0.0 and rate < 0.0 else rate
+    den = 1.0 + D_eq * eps_R * xi_s
+    return D_eq * strain_rate / den, -D_eq * eps_R * xi_T / den
 
 
 def secant_law(eps_el: float, D: float, spring: SpringSlack | None, S_w: float, L_w: float) -> tuple[float, float]:
@@ -213,20 +147,29 @@ def secant_law(eps_el: float, D: float, spring: SpringSlack | None, S_w: float, 
     return series_modulus(spring_stiffness(x_spring, spring), D, S_w, L_w), x_spring
 
 
-def algebraic_stress(eps: float, T: float, k: Kinetics, m: Transformation, D_A: float, D_M: float,
-                     eps_R: float, spring: SpringSlack | None, S_w: float, L_w: float) -> tuple[float, float, float]:
-    """(sigma, xi, spring elongation) of sigma = D_eq (eps - eps_R xi(T, sigma)) (MODEL-NOTES).
+def secant_stress(eps_el: float, xi: float, D_A: float, D_M: float, spring: SpringSlack | None, S_w: float,
+                  L_w: float) -> float:
+    """F(eps_el, xi) = D_eq eps_el: the stress an elastic strain implies at martensite fraction xi."""
+    if eps_el <= 0.0:
+        return 0.0
+    return secant_law(eps_el, youngs_modulus(xi, D_A, D_M), spring, S_w, L_w)[0] * eps_el
+
+
+def algebraic_stress(eps: float, T: float, branch, m: Transformation, D_A: float, D_M: float,
+                     eps_R: float, spring: SpringSlack | None, S_w: float, L_w: float):
+    """(sigma, xi's Fraction, spring elongation) of sigma = D_eq (eps - eps_R xi(T, sigma)) (MODEL-NOTES).
 
     sigma and xi are solved together: the root of sigma - S(sigma), S(sigma) the stress that the
-    strain implies with xi(T, sigma); S decreases with sigma, so the root lies in [0, S(0)].
+    strain implies with xi(T, sigma) on ``branch``; S decreases with sigma, so the root lies in
+    [0, S(0)].
     """
     def implied(sigma):
-        xi = martensite_fraction(k, T, sigma, m)[0]
-        eps_el = eps - eps_R * xi
+        f = branch.fraction(T, sigma, m)
+        eps_el = eps - eps_R * f.xi
         if eps_el <= 0.0:
-            return 0.0, xi, 0.0
-        D_eq, x_s = secant_law(eps_el, youngs_modulus(xi, D_A, D_M), spring, S_w, L_w)
-        return D_eq * eps_el, xi, x_s
+            return 0.0, f, 0.0
+        D_eq, x_s = secant_law(eps_el, youngs_modulus(f.xi, D_A, D_M), spring, S_w, L_w)
+        return D_eq * eps_el, f, x_s
 
     top = implied(0.0)
     if top[0] <= 0.0:
@@ -235,5 +178,27 @@ def algebraic_stress(eps: float, T: float, k: Kinetics, m: Transformation, D_A: 
         sigma = top[0]
     else:
         sigma = brentq(lambda s: s - implied(s)[0], 0.0, top[0], xtol=1e-300, rtol=1e-15, maxiter=500)
-    _, xi, x_s = implied(sigma)
-    return sigma, xi, x_s
+    _, f, x_s = implied(sigma)
+    return sigma, f, x_s
+
+
+def algebraic_law(eps: float, strain_rate: float, sigma: float, f, eps_R: float, D_A: float, D_M: float,
+                  spring: SpringSlack | None, S_w: float, L_w: float) -> tuple[float, float]:
+    """The algebraic law's stress rate as sigma' = s_free + s_T T': returns (s_free, s_T).
+
+    sigma = F(eps - eps_R xi, xi) with xi = xi(T, sigma) (``f``: its Fraction at the solution),
+    differentiated along the motion: sigma' = F_e eps' + G (xi_T T' + xi_s sigma'),
+    G = F_x - eps_R F_e (F's partials by central differences), solved for sigma'. 0 for a slack
+    wire (no elastic strain). The stress is no state of this law: the rate serves the memory
+    rule's driving tau = T - sigma/c (docs/hysteresis.md).
+    """
+    e = eps - eps_R * f.xi
+    if sigma <= 0.0 or e <= 0.0:
+        return 0.0, 0.0
+    F = lambda e_, x_: secant_stress(e_, x_, D_A, D_M, spring, S_w, L_w)  # noqa: E731
+    he, hx = 1e-6 * e, 1e-6
+    F_e = (F(e + he, f.xi) - F(e - he, f.xi)) / (2.0 * he)
+    F_x = (F(e, f.xi + hx) - F(e, f.xi - hx)) / (2.0 * hx)
+    G = F_x - eps_R * F_e
+    den = 1.0 - G * f.xi_s
+    return F_e * strain_rate / den, G * f.xi_T / den

@@ -1,4 +1,4 @@
-"""Eqs. (1)-(6) and (11) in plain Python: dynamics, friction, tendon geometry, heat balance.
+"""Eqs. (1)-(6) in plain Python: dynamics, friction, tendon geometry (Eq. 11: :mod:`.thermal`).
 
 Written from the paper (Gilardi et al., Robotica 28(5), 2010) and ``shared/MODEL-NOTES.md``,
 not from ``smafinger.model``. SI units; temperatures in degC as in the paper.
@@ -82,36 +82,3 @@ def acceleration(load: float, v: float, stuck: bool, inertia: float, dynamic: fl
     if stuck:
         return 0.0
     return (load - sliding_friction(v, dynamic, viscous)) / inertia
-
-
-# --------------------------------------------------------------------------------------------
-# Eq. (11): heat balance
-# --------------------------------------------------------------------------------------------
-def convection(T: float, h0: float, h2: float) -> float:
-    """h = h0 + h2 T^2 [W/(m^2 K)], T in degC (Eq. 11)."""
-    return h0 + h2 * T**2
-
-
-def joule_power_per_metre(drive: float, current: bool, whole_wire: bool, R_per_m: float, L_w: float) -> float:
-    """Electrical power per metre of wire [W/m] (Eq. 11's V^2/R_w term).
-
-    Voltage, ``per-metre`` reading (Eq. 11 literally): V^2 / R_w. Voltage, ``whole-wire``
-    reading: the power V^2 / (R_w L_w) of the whole wire, divided by its length. Current I:
-    I^2 R_w L_w over the whole wire, I^2 R_w per metre, in either reading.
-    """
-    if current:
-        return drive**2 * R_per_m
-    if whole_wire:
-        return terminal_power(drive, False, R_per_m, L_w) / L_w
-    return drive**2 / R_per_m
-
-
-def terminal_power(drive: float, current: bool, R_per_m: float, L_w: float) -> float:
-    """Power at the wire's terminals [W]: V^2 / (R_w L_w), or I^2 R_w L_w."""
-    R = R_per_m * L_w
-    return drive**2 * R if current else drive**2 / R
-
-
-def temperature_rate(T: float, P_per_m: float, h: float, T_amb: float, M_w: float, C_p: float, A_w: float) -> float:
-    """dT/dt of Eq. (11): M_w C_p dT/dt = P' - h A_w (T - T_amb)."""
-    return (P_per_m - h * A_w * (T - T_amb)) / (M_w * C_p)

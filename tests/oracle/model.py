@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 from . import material as mat
 from . import mechanics as mech
+from .hysteresis import Kinetics, MemoryBranch
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,9 @@ class Wire:
     path0: float  #: path length at the start
     xi_init: float
     T_init: float
+    latent_heat: float = 0.0  #: dH [J/kg] (0: off, as in the paper)
+    casing_capacity: float = 1.0  #: C_case [J/(m K)], two-node model
+    casing_loss: float = 0.0  #: G [W/(m K)], two-node model
 
 
 @dataclass(frozen=True)
@@ -110,8 +114,11 @@ class OracleModel:
     wires: tuple[Wire, ...]
     algebraic: bool  #: stress law
     whole_wire: bool  #: Joule heating reading
+    two_node: bool  #: thermal model: wire -> casing air -> open air
     restick: bool  #: friction sticking
-    damping_by_enable: bool
+    damping: str  #: which viscous coefficient: "heating-phase", "enabled" or "heating-value"
+    rule: str  #: hysteresis: "memory", "authors2020" or "deadband"
+    reversal: float  #: the deadband rule's reversal [degC] (0 for the other rules)
     V_H: float
     V_L: float
     pwm_period: float
@@ -125,7 +132,9 @@ class OracleModel:
 class WireVars:
     T: float
     sigma: float
-    energy: float = 0.0
+    electrical: float = 0.0  #: electrical energy at the terminals [J]
+    heat: float = 0.0  #: Joule heat put into the wire (Eq. 11's P' times L_w, integrated) [J]
+    T_case: float = 0.0  #: casing air [degC] (two-node model; unused by the single-node model)
 
 
 @dataclass(frozen=True)
@@ -140,7 +149,7 @@ class Vars:
 class WireHeld:
     drive: float  #: V, or A with a current drive
     heating: bool  #: its controller's heating phase (h of Eq. 11)
-    kinetics: mat.Kinetics
+    branch: Kinetics | MemoryBranch  #: where xi comes from (Eqs. 9-10)
 
 
 @dataclass(frozen=True)
@@ -155,9 +164,15 @@ class Held:
 
 @dataclass
 class Derivative:
-    """Named rates, named algebraic outputs and (if asked for) the round-off scale of each."""
+    """Named rates, named algebraic outputs and (if asked for) the round-off scale of each.
+
+    ``drivers``: per wire name, (dT/dt, dsigma/dt) of the wire's state (with the algebraic law,
+    the rate of the solved stress): what moves its kinetics (the memory rule's
+    tau = T - sigma/c, or T for the legacy rules).
+    """
 
     rates: dict[str, float] = field(default_factory=dict)
     outputs: dict[str, float] = field(default_factory=dict)
+    drivers: dict[str, tuple[float, float]] = field(default_factory=dict)
     rate_scales: dict[str, float] | None = None
     output_scales: dict[str, float] | None = None

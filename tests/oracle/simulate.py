@@ -8,13 +8,25 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .build import build
-from .material import Kinetics, Phase
 from .program import Step, parse, stretches
-from .trajectory import Hybrid, Mode, Trajectory, _held, _on_event, _Segment, _switch_branches
+from .rules import make_rule
+from .trajectory import (
+    MECHANISM_STATE, WIRE_STATE, Hybrid, Mode, Trajectory, _Segment, commit, held_inputs, index, on_event,
+)
 
-#: absolute tolerances per state component at rtol = 1e-6 (scaled with rtol):
-#: q [rad or m], v, error integral, then per wire T [degC], sigma [Pa], energy [J]
-_ATOL = (1e-9, 1e-7, 1e-9, 1e-6, 1.0, 1e-6)
+#: absolute tolerances per state component at rtol = 1e-6 (scaled with rtol)
+_ATOL_MECHANISM = {"q": 1e-9, "v": 1e-7, "error_integral": 1e-9}  # rad or m, their rates
+_ATOL_WIRE = {"T": 1e-6, "sigma": 1.0, "electrical": 1e-6, "heat": 1e-6, "T_case": 1e-6}  # degC, Pa, J
+#: the per-wire signals of a trajectory: the state's, and the algebraic ones (solved at the samples)
+SIGNALS = WIRE_STATE + ("xi",)
+
+
+def initial_state(m) -> np.ndarray:
+    """q0 at rest, each wire at T_init and its initial stress, no energy, its casing at the ambient."""
+    start = {"T": [w.T_init for w in m.wires], "sigma": [w.sigma0 for w in m.wires],
+             "electrical": [0.0] * len(m.wires), "heat": [0.0] * len(m.wires),
+             "T_case": [w.T_amb for w in m.wires]}
+    return np.array([m.mechanism.q0, 0.0, 0.0] + [v for k in WIRE_STATE for v in start[k]])
 
 
 def simulate(params, program: str | list[Step], kind: str = "voltage", t_end: float = 20.0,
@@ -22,10 +34,11 @@ def simulate(params, program: str | list[Step], kind: str = "voltage", t_end: fl
              max_events: int = 10_000, outputs: bool = True) -> Trajectory:
     """Integrate an open-loop ``program`` (``"T:V_1[:V_2],..."``, read as ``kind``) from rest.
 
-    ``params`` is a parameter set (any mechanism); the run starts as the engine's does (q0 at
-    rest, each wire at T_init, xi_init and its initial stress, on the hold branch) with the
-    open-loop target q_F = the initial coordinate. Returns a :class:`Trajectory` sampled every
-    ``sample_s`` with ``info``: wall_s, nfev (right-hand-side calls), calls (of solve_ivp), events.
+    ``params`` is a parameter set (any mechanism, any hysteresis rule; the memory rule needs
+    c_A = c_M); the run starts as the engine's does (q0 at rest, each wire at T_init, xi_init
+    and its initial stress, not yet moved along any branch) with the open-loop target q_F = the
+    initial coordinate. Returns a :class:`Trajectory` sampled every ``sample_s`` with ``info``:
+    wall_s, nfev (right-hand-side calls), calls (of solve_ivp), events (by kind).
     ``outputs = False`` skips solving sigma and xi at the samples (NaN there): the state alone.
     """
     m = build(params)
@@ -37,26 +50,26 @@ def simulate(params, program: str | list[Step], kind: str = "voltage", t_end: fl
     steps = parse(program, kind, n, m.V_H) if isinstance(program, str) else list(program)
     if not steps or steps[0].t > 0.0:  # off until the first step, as the engine's initial commands
         steps.insert(0, Step(0.0, (m.V_H,) * n, (0.0,) * n))
-    rev = params.minor_loop_reversal_C
     if atol is None:
-        a = np.array(_ATOL) * (rtol / 1e-6)
-        atol = np.concatenate([a[:3], np.repeat(a[3:], n)])
-    y = np.array([m.mechanism.q0, 0.0, 0.0] + [w.T_init for w in m.wires] + [w.sigma0 for w in m.wires] + [0.0] * n)
-    hy = Hybrid(Mode.SLIDING, 0, [Kinetics(Phase.HOLD, w.xi_init, w.xi_init) for w in m.wires],
-                [w.T_init for w in m.wires])
+        scale = rtol / 1e-6
+        atol = np.array([_ATOL_MECHANISM[k] for k in MECHANISM_STATE]
+                        + [_ATOL_WIRE[k] for k in WIRE_STATE for _ in range(n)]) * scale
+    y = initial_state(m)
+    hy = Hybrid(Mode.SLIDING, 0, [make_rule(m.rule, w.xi_init, w.T_init, m.reversal, w.transformation)
+                                  for w in m.wires])
     grid = np.round(np.arange(0.0, t_end + 0.5 * sample_s, sample_s), 12)
-    rows = np.full((grid.size, 3 + 4 * n), np.nan)  # q, v, E, then T, sigma, xi, energy per wire
-    info = {"nfev": 0, "calls": 0, "events": 0}
+    rows = {"mechanism": np.full((grid.size, len(MECHANISM_STATE)), np.nan),
+            "wires": np.full((grid.size, len(SIGNALS), n), np.nan)}
+    info = {"nfev": 0, "calls": 0, "events": 0, "by_kind": {}}
     t0 = time.perf_counter()
     for k, st in enumerate(stretches(steps, t_end, m.pwm_period, 0.0 if current else m.V_L)):
-        seg = _Segment(m, hy, _held(m, hy, st, current), rev)
+        seg = _Segment(m, hy, held_inputs(m, hy, st, current))
+        commit(seg, y)  # the drive changed: each wire's branch for the stretch, then (at the start) Eq. (2)
         if k == 0:
-            _initial_stick(seg, hy, y)
-            seg = _Segment(m, hy, _held(m, hy, st, current), rev)
-        _switch_branches(seg, y, rev)
+            _initial_stick(_Segment(m, hy, held_inputs(m, hy, st, current)), hy, y)
         t = st.t0
         while t < st.t1:
-            seg = _Segment(m, hy, _held(m, hy, st, current), rev)
+            seg = _Segment(m, hy, held_inputs(m, hy, st, current))
             named = seg.events()
             sol = solve_ivp(seg.rhs, (t, st.t1), y, method=method, rtol=rtol, atol=atol, dense_output=True,
                             events=[f for _, f in named] or None)
@@ -67,18 +80,26 @@ def simulate(params, program: str | list[Step], kind: str = "voltage", t_end: fl
             _sample(seg, sol, t, rows, grid, outputs)
             y = sol.y[:, -1].copy()
             if sol.status == 1:
-                info["events"] += 1
-                if info["events"] > max_events:
-                    raise RuntimeError(f"more than {max_events} events by t = {sol.t[-1]}")
+                _count(info, named, sol, max_events)
                 times = [te[0] if te.size else np.inf for te in sol.t_events]
-                _on_event(named[int(np.argmin(times))][0], seg, y)
+                forced = on_event(named[int(np.argmin(times))][0], seg, y)
+                commit(_Segment(m, hy, held_inputs(m, hy, st, current)), y, forced)
                 t = sol.t[-1]
             else:
                 t = st.t1
     info["wall_s"] = time.perf_counter() - t0
-    wires = {w.name: {key: rows[:, 3 + j * n + i] for j, key in enumerate(("T", "sigma", "xi", "energy"))}
-             for i, w in enumerate(m.wires)}
-    return Trajectory(grid, rows[:, 0], rows[:, 1], rows[:, 2], wires, info)
+    mech = rows["mechanism"]
+    wires = {w.name: {key: rows["wires"][:, j, i] for j, key in enumerate(SIGNALS)} for i, w in enumerate(m.wires)}
+    return Trajectory(grid, mech[:, 0], mech[:, 1], mech[:, 2], wires, info)
+
+
+def _count(info: dict, named, sol, max_events: int) -> None:
+    info["events"] += 1
+    if info["events"] > max_events:
+        raise RuntimeError(f"more than {max_events} events by t = {sol.t[-1]}")
+    times = [te[0] if te.size else np.inf for te in sol.t_events]
+    kind = named[int(np.argmin(times))][0].split()[0]
+    info["by_kind"][kind] = info["by_kind"].get(kind, 0) + 1
 
 
 def _initial_stick(seg: _Segment, hy: Hybrid, y) -> None:
@@ -97,15 +118,16 @@ def _sample(seg: _Segment, sol, t: float, rows, grid, outputs: bool) -> None:
         return
     n = seg.n
     states = sol.sol(np.clip(grid[sel], t, sol.t[-1]))
-    rows[sel, : 3 + n] = states[: 3 + n].T  # q, v, error integral, T
-    rows[sel, 3 + 3 * n:] = states[3 + 2 * n:].T  # energy
+    rows["mechanism"][sel] = states[: len(MECHANISM_STATE)].T
+    for j, key in enumerate(WIRE_STATE):
+        rows["wires"][sel, j, :] = states[[index(key, i, n) for i in range(n)]].T
     if not outputs:
         return
-    for j, col in zip(sel, states.T):
+    for row, col in zip(sel, states.T):
         d = seg.at(None, col)
         for i, w in enumerate(seg.m.wires):
-            rows[j, 3 + n + i] = d.outputs[w.name + ".sigma"]
-            rows[j, 3 + 2 * n + i] = d.outputs[w.name + ".xi"]
+            rows["wires"][row, WIRE_STATE.index("sigma"), i] = d.outputs[w.name + ".sigma"]
+            rows["wires"][row, len(WIRE_STATE), i] = d.outputs[w.name + ".xi"]
 
 
 def simulate_baseline(params, voltage="0:8:0,6:0:0", t_end=20.0, method="RK45", rtol=1e-6, atol=None,

@@ -1,8 +1,8 @@
 """Open-loop runs of the oracle with ``scipy.integrate.solve_ivp``; the discrete parts as events.
 
 Between the program's changes of drive (and PWM edges) the right-hand side is smooth but for
-three hybrid parts, each handled as a terminal event that stops the integration, updates the
-discrete state and restarts it:
+hybrid parts, each handled as a terminal event that stops the integration, updates the discrete
+state and restarts it:
 
 - stick/slip, Eq. (2): a held mechanism breaks away when |M_E| rises through M_SF; with the
   ``restick`` option a moving one sticks again when |q'| falls through the stick velocity while
@@ -10,25 +10,31 @@ discrete state and restarts it:
 - end stops (the slider): reaching one stops the slider there; it stays while its load pushes
   into the stop (or, with ``restick``, while |load| <= the static friction) and leaves when
   pulled away by more than the static friction;
-- kinetics branches (MODEL-NOTES): at each change of drive a wire's branch follows the sign of
-  dT/dt (with a constant drive T is monotone, so the sign holds until the next change); with
-  ``minor_loop_reversal_C`` > 0 the branch changes only once T has moved back by that much from
-  its extreme since the last change, an event on T. At a change the new curve's start value is
-  re-solved through the current xi (continuous xi).
+- kinetics (:mod:`.rules`): each wire's driving quantity (T, or tau = T - sigma/c for the memory
+  rule) turning back (a reversal), and the levels at which its rule acts (a memory loop's
+  target; the dead band's thresholds).
+
+At every event, and at every change of drive, each wire's rule commits the state and takes the
+sign of its driving rate, 0 (still) within ``RATE_TOL`` of 0; a still wire's start is an event.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
 
-from .material import Kinetics, Phase, start_through
 from .model import Held, OracleModel, Vars, WireHeld, WireVars
 from .program import Stretch
 from .rhs import derivative
+
+#: the state vector: the mechanism's components, then each per-wire component for every wire
+MECHANISM_STATE = ("q", "v", "error_integral")
+WIRE_STATE = ("T", "sigma", "electrical", "heat", "T_case")
+#: a driving rate (degC/s) within this of 0 is round-off: the wire is still (a wire moving at it
+#: moves its tau by 1e-8 degC in 10 s); a turn is taken once the rate is this far the other way
+RATE_TOL = 1e-9
 
 
 class Mode(Enum):
@@ -39,12 +45,11 @@ class Mode(Enum):
 
 @dataclass
 class Hybrid:
-    """The discrete state: stick/slip mode, the stop held against, each wire's kinetics."""
+    """The discrete state: stick/slip mode, the stop held against, each wire's rule (:mod:`.rules`)."""
 
     mode: Mode
     stop: int  #: +1 held at q_max, -1 at q_min, 0 elsewhere
-    kinetics: list[Kinetics]
-    turns: list[float]  #: extreme temperature since each wire's last change of branch
+    rules: list
 
 
 @dataclass
@@ -55,26 +60,30 @@ class Trajectory:
     q: np.ndarray
     v: np.ndarray
     error_integral: np.ndarray
-    wires: dict[str, dict[str, np.ndarray]]  #: name -> T, sigma, xi, energy
+    wires: dict[str, dict[str, np.ndarray]]  #: name -> T, sigma, xi, electrical, heat, T_case
     info: dict = field(default_factory=dict)  #: wall_s, nfev, calls, events
 
 
+def index(key: str, i: int, n: int) -> int:
+    """Position of wire i's component ``key`` in the state vector of n wires."""
+    return len(MECHANISM_STATE) + WIRE_STATE.index(key) * n + i
+
+
 def _vars(y, n: int) -> Vars:
-    return Vars(y[0], y[1], y[2], tuple(WireVars(y[3 + i], y[3 + n + i], y[3 + 2 * n + i]) for i in range(n)))
+    wires = tuple(WireVars(**{k: y[index(k, i, n)] for k in WIRE_STATE}) for i in range(n))
+    return Vars(y[0], y[1], y[2], wires)
 
 
 def _vector(m: OracleModel, d) -> list[float]:
-    names = [w.name for w in m.wires]
     r = d.rates
-    return ([r["q"], r["v"], r["error_integral"]] + [r[n + ".T"] for n in names]
-            + [r[n + ".sigma"] for n in names] + [r[n + ".energy"] for n in names])
+    return [r[k] for k in MECHANISM_STATE] + [r[f"{w.name}.{k}"] for k in WIRE_STATE for w in m.wires]
 
 
 class _Segment:
     """The right-hand side and the events of one stretch of constant drive and discrete state."""
 
-    def __init__(self, m: OracleModel, hy: Hybrid, held: Held, rev: float):
-        self.m, self.hy, self.held, self.rev = m, hy, held, rev
+    def __init__(self, m: OracleModel, hy: Hybrid, held: Held):
+        self.m, self.hy, self.held = m, hy, held
         self.n = len(m.wires)
         self._key, self._d = None, None
         self.nfev = 0
@@ -89,8 +98,18 @@ class _Segment:
         self.nfev += 1
         return _vector(self.m, self.at(t, y))
 
+    def driving_rate(self, i: int, t, y) -> float:
+        return self.hy.rules[i].rate(*self.at(t, y).drivers[self.m.wires[i].name])
+
+    def level(self, i: int, t, y) -> float:
+        w = self.m.wires[i]
+        return self.hy.rules[i].level(y[index("T", i, self.n)], self.at(t, y).outputs[w.name + ".sigma"])
+
     def events(self) -> list[tuple[str, object]]:
         """(name, event function) pairs for solve_ivp, from the discrete state."""
+        return self._mechanical_events() + self._kinetics_events()
+
+    def _mechanical_events(self):
         mc, hy, ev = self.m.mechanism, self.hy, []
         load = lambda t, y: self.at(t, y).outputs["load"]  # noqa: E731
         if hy.mode is Mode.STUCK:
@@ -98,24 +117,29 @@ class _Segment:
                 ev.append(("release", _event(lambda t, y: -hy.stop * load(t, y) - mc.static, 1)))
             else:
                 ev.append(("release", _event(lambda t, y: abs(load(t, y)) - mc.static, 1)))
-        else:
-            # with no static friction Eq. (2) holds only where the load is exactly 0: no sticking
-            if self.m.restick and mc.static > 0.0 and hy.mode is Mode.SLIDING:
-                ev.append(("slow", _event(lambda t, y: abs(y[1]) - mc.stick_velocity, -1)))
-            if hy.mode is Mode.CREEPING:
-                ev.append(("weak", _event(lambda t, y: abs(load(t, y)) - mc.static, -1)))
-                ev.append(("fast", _event(lambda t, y: abs(y[1]) - mc.stick_velocity, 1)))
-            if math.isfinite(mc.q_max):
-                ev.append(("stop+", _event(lambda t, y: y[0] - mc.q_max, 1)))
-            if math.isfinite(mc.q_min):
-                ev.append(("stop-", _event(lambda t, y: y[0] - mc.q_min, -1)))
-        if self.rev > 0.0:
-            for i, k in enumerate(hy.kinetics):
-                j = 3 + i
-                if k.phase is not Phase.COOLING:  # heating or holding: a fall by rev from the turn
-                    ev.append((f"cool{i}", _event(lambda t, y, j=j, c=hy.turns[i] - self.rev: y[j] - c, -1)))
-                if k.phase is not Phase.HEATING:
-                    ev.append((f"heat{i}", _event(lambda t, y, j=j, c=hy.turns[i] + self.rev: y[j] - c, 1)))
+            return ev
+        # with no static friction Eq. (2) holds only where the load is exactly 0: no sticking
+        if self.m.restick and mc.static > 0.0 and hy.mode is Mode.SLIDING:
+            ev.append(("slow", _event(lambda t, y: abs(y[1]) - mc.stick_velocity, -1)))
+        if hy.mode is Mode.CREEPING:
+            ev.append(("weak", _event(lambda t, y: abs(load(t, y)) - mc.static, -1)))
+            ev.append(("fast", _event(lambda t, y: abs(y[1]) - mc.stick_velocity, 1)))
+        if np.isfinite(mc.q_max):
+            ev.append(("stop+", _event(lambda t, y: y[0] - mc.q_max, 1)))
+        if np.isfinite(mc.q_min):
+            ev.append(("stop-", _event(lambda t, y: y[0] - mc.q_min, -1)))
+        return ev
+
+    def _kinetics_events(self):
+        ev = []
+        for i, rule in enumerate(self.hy.rules):
+            s = rule.motion
+            if s:  # the driving quantity turns back: its rate goes RATE_TOL the other way
+                ev.append((f"turn {i}", _event(lambda t, y, i=i, s=s: s * self.driving_rate(i, t, y) + RATE_TOL, -1)))
+            else:  # a still wire starts to move
+                ev.append((f"start {i}", _event(lambda t, y, i=i: abs(self.driving_rate(i, t, y)) - RATE_TOL, 1)))
+            for name, mark, direction in rule.marks():
+                ev.append((f"{name} {i}", _event(lambda t, y, i=i, c=mark: self.level(i, t, y) - c, direction)))
         return ev
 
 
@@ -127,48 +151,32 @@ def _event(f, direction: int):
 # --------------------------------------------------------------------------------------------
 # discrete updates
 # --------------------------------------------------------------------------------------------
-def next_phase(phase: Phase, dT: float, T: float, turn: float, rev: float) -> tuple[Phase, float]:
-    """(branch, turn) at a change of drive: the sign of dT/dt, or the reversal dead band ``rev``."""
-    if rev <= 0.0:
-        return (Phase.HEATING if dT > 0.0 else Phase.COOLING if dT < 0.0 else Phase.HOLD), T
-    if phase is Phase.HEATING:
-        if T < turn - rev:
-            return Phase.COOLING, T
-        return phase, max(turn, T)
-    if phase is Phase.COOLING:
-        if T > turn + rev:
-            return Phase.HEATING, T
-        return phase, min(turn, T)
-    if T > turn + rev:
-        return Phase.HEATING, T
-    if T < turn - rev:
-        return Phase.COOLING, T
-    return phase, turn
+def _sign(x: float) -> int:
+    return int(x > 0.0) - int(x < 0.0)
 
 
-def enter(phase: Phase, k: Kinetics, xi: float, T: float, sigma: float, m) -> Kinetics:
-    """The kinetics on entering ``phase`` with xi at (T, sigma): continuous xi (MODEL-NOTES)."""
-    if phase is Phase.HOLD:
-        return Kinetics(phase, k.start, xi)
-    return Kinetics(phase, start_through(phase, xi, T, sigma, m), k.held)
+def commit(seg: _Segment, y, forced: dict[int, int] | None = None) -> None:
+    """Every wire's rule commits the state y and takes the sign of its driving rate (0 within RATE_TOL).
 
-
-def _switch_branches(seg: _Segment, y, rev: float) -> None:
-    """At a change of drive: each wire's branch for the stretch (the drive is in ``seg.held``)."""
+    ``forced``: wire -> sign where the trajectory stopped because that wire's rate turned or
+    started (there the rate is RATE_TOL up to the event's location).
+    """
+    forced = forced or {}
     d = seg.at(None, y)
-    hy = seg.hy
-    for i, w in enumerate(seg.m.wires):
-        T = y[3 + i]
-        phase, hy.turns[i] = next_phase(hy.kinetics[i].phase, d.rates[w.name + ".T"], T, hy.turns[i], rev)
-        if phase is not hy.kinetics[i].phase:
-            hy.kinetics[i] = enter(phase, hy.kinetics[i], d.outputs[w.name + ".xi"], T,
-                                   d.outputs[w.name + ".sigma"], w.transformation)
+    for i, (w, rule) in enumerate(zip(seg.m.wires, seg.hy.rules)):
+        rate = seg.driving_rate(i, None, y)
+        sign = forced.get(i, _sign(rate) if abs(rate) > RATE_TOL else 0)
+        rule.update(sign, y[index("T", i, seg.n)], d.outputs[w.name + ".sigma"], d.outputs[w.name + ".xi"])
 
 
-def _on_event(name: str, seg: _Segment, y) -> None:
-    """Apply the event ``name`` to the discrete state ``seg.hy`` and the state vector y."""
+def on_event(name: str, seg: _Segment, y) -> dict[int, int]:
+    """Apply the event ``name`` to the discrete state ``seg.hy`` and the state vector y.
+
+    Returns the wires whose driving rate turned or started, with their new sign (for :func:`commit`).
+    """
     hy, mc, d = seg.hy, seg.m.mechanism, seg.at(None, y)
     load = d.outputs["load"]
+    forced = {}
     if name == "release":
         hy.mode, hy.stop = Mode.SLIDING, 0
     elif name in ("slow", "weak"):
@@ -183,18 +191,24 @@ def _on_event(name: str, seg: _Segment, y) -> None:
             hy.mode, hy.stop = Mode.STUCK, side
         else:
             hy.mode = Mode.SLIDING
-    else:  # a kinetics dead band: heat<i> or cool<i>
-        i = int(name[4:])
-        w = seg.m.wires[i]
-        phase = Phase.HEATING if name.startswith("heat") else Phase.COOLING
-        hy.kinetics[i] = enter(phase, hy.kinetics[i], d.outputs[w.name + ".xi"], y[3 + i],
-                               d.outputs[w.name + ".sigma"], w.transformation)
-        hy.turns[i] = y[3 + i]
+    else:  # a wire's kinetics: "turn <i>", or one of its rule's marks
+        kind, i = name.split()
+        i = int(i)
+        rule, w = hy.rules[i], seg.m.wires[i]
+        if kind == "turn":
+            forced[i] = -rule.motion
+        elif kind == "start":
+            forced[i] = _sign(seg.driving_rate(i, None, y))
+        else:
+            rule.on_mark(kind, y[index("T", i, seg.n)], d.outputs[w.name + ".sigma"], d.outputs[w.name + ".xi"])
     if hy.mode is Mode.STUCK:
         y[1] = 0.0
+    return forced
 
 
-def _held(m: OracleModel, hy: Hybrid, st: Stretch, current: bool) -> Held:
-    viscous = m.mechanism.viscous_heating if any(st.on) else m.mechanism.viscous_cooling
+def held_inputs(m: OracleModel, hy: Hybrid, st: Stretch, current: bool) -> Held:
+    """The inputs held over a stretch: open loop, every wire's heating phase is its drive being on."""
+    hot = m.damping == "heating-value" or any(st.on)
+    viscous = m.mechanism.viscous_heating if hot else m.mechanism.viscous_cooling
     return Held(hy.mode is Mode.STUCK, viscous, m.initial_target, 1.0, current,
-                tuple(WireHeld(dr, on, k) for dr, on, k in zip(st.drives, st.on, hy.kinetics)))
+                tuple(WireHeld(dr, on, rule.held()) for dr, on, rule in zip(st.drives, st.on, hy.rules)))
