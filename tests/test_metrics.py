@@ -112,10 +112,76 @@ def test_cooling_phase_metrics_on_a_known_signal():
     assert m["cooling_start_s"] == pytest.approx(2.01)
     assert m["cooling_s"] == pytest.approx(3.0, abs=0.011)
     assert m["cooling_rate_C_s"] == pytest.approx(2.0)
-    assert m["peak_past_deg"] == pytest.approx(0.2, abs=1e-3)
-    assert m["overshoot_after_deg"] == pytest.approx(0.2, abs=1e-3)
+    assert m["overshoot_deg"] == pytest.approx(0.2, abs=1e-3)
+    assert m["fall_back_deg"] == pytest.approx(0.2, abs=1e-3)
     flat = M.cooling_phase_metrics(t, np.full_like(t, -35.0), T_C, -30.0)
-    assert flat["cooling_s"] is None and flat["peak_past_deg"] == 0.0
+    assert flat["cooling_s"] is None and flat["overshoot_deg"] == 0.0 and flat["fall_back_deg"] is None
+
+
+def test_cooling_phase_overshoot_is_the_one_definition():
+    """The overshoot of the cooling-phase metrics is overshoot_deg of the whole move; the fall back
+    is the same function against the move's direction, after the phase."""
+    t = np.arange(0.0, 12.0, 0.01)
+    theta = np.where(t < 2.0, -40.0 + 5.0 * t, -30.0 + 0.3 * np.sin(np.pi * (t - 2.0) / 2.0) * np.exp(-(t - 2.0) / 4))
+    m = M.cooling_phase_metrics(t, theta, 90.0 - t, -30.0)
+    assert m["overshoot_deg"] == M.overshoot_deg(theta, -30.0, M.motion_direction(-40.0, -30.0))
+    after = M.window(t, m["cooling_start_s"] + m["cooling_s"], m["cooling_start_s"] + m["cooling_s"] + M.COOLING_WINDOW_S)
+    assert m["fall_back_deg"] == M.overshoot_deg(theta[after], -30.0, -1.0) > 0.0
+
+
+def test_rest_time_after_the_last_fast_sample():
+    v = np.where(T < 4.0, 2.0, 0.0)
+    v[(T > 6.0) & (T < 6.5)] = 0.06  # slow creep above the threshold
+    assert M.rest_time(T, v, 0.0, 20.0) == pytest.approx(6.5, abs=2e-3)
+    assert M.rest_time(T, v, 0.0, 20.0, threshold=0.1) == pytest.approx(4.0, abs=2e-3)
+    assert M.rest_time(T, np.zeros_like(T), 0.0, 20.0) == 0.0
+    assert M.rest_time(T, np.ones_like(T), 0.0, 20.0) is None
+
+
+def test_cooled_time_waits_for_every_wire_it_started_with_transformed():
+    hot = np.clip(0.2 + 0.1 * T, 0.0, 1.0)  # martensite (0.999) at 7.99 s
+    hotter = np.clip(-0.6 + 0.1 * T, 0.0, 1.0)  # at 15.99 s
+    cold = np.ones_like(T)
+    assert M.cooled_time(T, {"a": hot, "b": cold}, 2.0, 20.0) == pytest.approx(5.99, abs=2e-3)
+    assert M.cooled_time(T, {"a": hot, "b": hotter}, 2.0, 20.0) == pytest.approx(13.99, abs=2e-3)
+    assert M.cooled_time(T, {"a": hot, "b": hotter}, 2.0, 10.0) is None  # not back before the end
+    assert M.cooled_time(T, {"b": cold}, 2.0, 20.0) == 0.0
+    # a wire transformed during the window (martensite at its start) does not count
+    heated = np.where(T < 5.0, 1.0, 0.3)
+    assert M.cooled_time(T, {"a": hot, "c": heated}, 2.0, 20.0) == pytest.approx(5.99, abs=2e-3)
+
+
+def test_onoff_cycles_on_a_known_signal():
+    """Two cycles: the casing rises 2 degC per cycle and keeps it; the joint returns exponentially,
+    with a time constant that doubles in the second cycle."""
+    t = np.round(np.arange(0.0, 40.0 + 1e-9, 1e-3), 9)
+    on = ((0.0, 5.0), (20.0, 25.0))
+    theta = np.full_like(t, -40.0)
+    casing = 23.0 + np.where(t < 20.0, 2.0 * np.minimum(t, 5.0) / 5.0, 2.0 + 2.0 * np.minimum(t - 20.0, 5.0) / 5.0)
+    xi = np.ones_like(t)
+    for (a, b), tau in zip(on, (1.0, 2.0)):
+        heat, cool = (t >= a) & (t <= b), t > b
+        theta[heat] = -40.0 + 3.0 * (t[heat] - a)
+        seg = cool & (t < a + 20.0)
+        theta[seg] = -40.0 + 15.0 * np.exp(-(t[seg] - b) / tau)
+        xi[heat] = 0.5
+        xi[seg] = np.where(t[seg] - b < tau, 0.5, 1.0)
+    c = M.onoff_cycle_metrics(t, theta, 100.0 - 0.0 * t, casing, xi, on)
+    assert [x["casing_start_C"] for x in c] == [23.0, 25.0]
+    assert [x["casing_end_C"] for x in c] == pytest.approx([25.0, 27.0])
+    assert [x["range_deg"] for x in c] == pytest.approx([15.0, 15.0])
+    # 90% of the way back after tau ln 10
+    assert [x["cooling_s"] for x in c] == pytest.approx([np.log(10.0), 2.0 * np.log(10.0)], abs=2e-3)
+    assert [x["martensite_s"] for x in c] == pytest.approx([1.0, 2.0], abs=2e-3)
+    assert c[1]["end_s"] == 40.0 and c[0]["end_s"] == 20.0
+
+
+def test_segment_energy_is_named_for_what_it_is():
+    span = M.Span(0, 0.0, 10.0, -30.0, "upper", 4.0)
+    elec, heat = {"upper": 3.0 * T}, {"upper": 0.5 * T}
+    seg = M.segment_metrics(T, -40.0 + T, span, {"upper": 20.0 + T}, elec, heat_J=heat)
+    assert seg["electrical_energy_J"] == seg["energy_J"] == {"upper": pytest.approx(30.0)}
+    assert seg["heat_J"] == {"upper": pytest.approx(5.0)}
 
 
 # ---- cycles ---------------------------------------------------------------------------------

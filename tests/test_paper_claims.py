@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from smafinger import scenarios
@@ -72,7 +73,8 @@ def test_registry_names_are_versioned_and_cite_a_figure():
         s = scenarios.get(n)
         assert re.search(r"-v[0-9]+$", n) and s.name == n, n
         assert s.figure and s.description
-    for required in ("fig8-h0-60-upper-v1", "fig11-controller-off-v1", "fig11-controller-off-v2", "fig15-independent-v1",
+    for required in ("fig8-h0-60-upper-v1", "fig10a-two-node-v1", "fig11-controller-off-v1", "fig11-controller-off-v2",
+                     "fig15-independent-v1", "fig15-independent-v2", "fig15-independent-scheduled-v2",
                      "fig15-cooperative-v1", "authors2020-profile1-v1", "authors2020-profile2-v1"):
         assert required in names
 
@@ -121,9 +123,54 @@ def test_fig15_on_reach_cycle_time_is_the_sum_of_reached_s(runs, name):
     assert run.derived["elapsed_s"] == pytest.approx(run.derived["cycle_s"] + (n - 1) * run.spec.hold_s, abs=1e-6)
 
 
-def test_fig15_cycles_visit_every_target(runs):
-    for name in ("fig15-independent-v1", "fig15-cooperative-v1",
-                 "fig15-independent-scheduled-v1", "fig15-cooperative-scheduled-v1"):
-        segs = runs[name].summary["segments"]
-        assert [s["target_deg"] for s in segs][-1] == -40.0
-        assert all(s["reached_s"] is not None for s in segs), name
+#: Fig. 15 runs that do not reach every target at the scenarios' 1 ms step (report.md, issue 10's section:
+#: after a full transformation the rate-form stress law leaves the joint 1-2.6 deg off -40 deg, where the
+#: returns creep on the integral term; at 0.1 ms they reach it)
+RETURN_GAP_AT_1MS = {"fig15-independent-v2", "fig15-independent-scheduled-v2", "fig15-independent-scheduled-v1"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=[pytest.mark.xfail(
+    strict=True, reason="the return to -40 deg is not reached at 1 ms (rate-law drift)")] if n in RETURN_GAP_AT_1MS else [])
+    for n in scenarios.names() if n.startswith("fig15-")])
+def test_fig15_cycles_visit_every_target(runs, name):
+    segs = runs[name].summary["segments"]
+    assert [s["target_deg"] for s in segs][-1] == -40.0
+    assert all(s["reached_s"] is not None for s in segs), [s["reached_s"] for s in segs]
+
+
+@pytest.mark.parametrize("name", ["fig15-independent-v2", "fig15-independent-scheduled-v2"])
+def test_fig15_independent_v2_uses_only_the_agonist(runs, name):
+    """Sec. 4.1: one actuator at a time, the other "simply works as a bias spring": the upper wire
+    for the extension and its return, the lower one for the flexion and its return."""
+    r = runs[name].result
+    seg = r.signal("segment")
+    for wire, own in (("upper", (0, 1)), ("lower", (2, 3))):
+        other, mine = ~np.isin(seg, own), np.isin(seg, own)
+        assert np.all(r.signal(f"enabled_{wire}")[other] == 0.0) and np.all(r.signal(f"duty_{wire}")[other] == 0.0)
+        assert not mine.any() or r.signal(f"duty_{wire}")[mine].max() > 0.0  # (its segments may not have started)
+    assert np.isin(seg, (0, 1)).any()
+
+
+def test_fig15_v1_independent_uses_the_antagonist_for_the_return(runs):
+    """What -v2 corrects: the v1 schedule enables the lower wire (once the upper one is back to
+    martensite) for what should be the upper wire's passive return to -40 deg."""
+    r = runs["fig15-independent-scheduled-v1"].result
+    back = r.signal("segment") == 1
+    assert np.any(r.signal("enabled_lower")[back] == 1.0) and r.signal("duty_lower")[back].mean() > 0.0
+    assert np.all(r.signal("enabled_upper")[back] == 0.0)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "engine: control/controller.py viscous_coefficient treats damping_switch = heating-value as heating-phase; "
+    "the Fig. 15 study sets one C_DF through C_DF_cooling_Nms instead"))
+def test_heating_value_rule_is_one_damping_coefficient():
+    s = scenarios.get("fig13-extension-case1-v1")
+    rule = run_spec(s.spec(["damping_switch=heating-value"]))
+    one = run_spec(s.spec([f"C_DF_cooling_Nms={s.parameters().C_DF_heating_Nms}"]))
+    assert np.array_equal(rule.signal("theta_deg"), one.signal("theta_deg"))
+
+
+def test_every_figure_draws(runs, tmp_path):
+    for f in scenarios.FIGURES:
+        f.plot([runs[s.name] for s in f.scenarios], f.title, tmp_path / f"{f.key}.png")
+        assert (tmp_path / f"{f.key}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f.key

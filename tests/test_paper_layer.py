@@ -153,3 +153,96 @@ def test_findings_follow_the_numbers():
     assert "below the paper's" not in close and "outside the" not in close
     never = "\n".join(F.findings(_rows(18.5, 14.7, **{"tol0.1": (20.8, None)})))
     assert "within 0.1 deg: the co-operative cycle does not finish within 80 s" in never
+
+
+# ---- studies: one change per variant ------------------------------------------------------------
+def test_study_variants_change_only_what_they_name():
+    from smafinger.paper import studies
+    from smafinger.scenarios import get as scenario
+
+    keys = [k for k, _ in studies.tasks()]
+    assert len(keys) == len(set(keys))
+    for study in studies.STUDIES:
+        for v in study.variants:
+            for name in study.scenarios:
+                if not v.applies(name):
+                    continue
+                base, spec = scenario(name).spec(), v.spec(name)
+                now = spec.params.to_dict()
+                changed = {k for k, x in base.params.to_dict().items() if now[k] != x}
+                assert changed <= {k for k, _ in v.overrides.params}, (v.key, name, changed)
+                assert all(now[k] == (x.label if hasattr(x, "label") else x) for k, x in v.overrides.params)
+                assert spec.dt_s == (v.dt_s or base.dt_s) and spec.profile == base.profile
+
+
+def test_one_cdf_variant_is_one_coefficient():
+    from smafinger.paper import studies
+
+    for which, ov in studies.ONE_CDF.items():
+        p = ov.apply(get("paper2010"))
+        assert p.C_DF_heating_Nms == p.C_DF_cooling_Nms == studies.C_DF[which]
+
+
+# ---- the studies' findings: computed, not written ---------------------------------------------------
+def _brief(move, ret, final):
+    return {"move_s": move, "return_s": ret, "return_settle_s": None, "final_deg": final}
+
+
+def test_hysteresis_findings_count_what_the_step_recovers():
+    from smafinger.paper.cycle_findings import hysteresis_findings
+
+    table = [{"scenario": "a", "deadband": _brief(5.0, 7.0, -40.05), "as-specified": _brief(5.0, None, -41.3),
+              "dt0.1ms": _brief(5.0, 6.3, -40.15), "algebraic": _brief(5.0, 6.6, -40.0)},
+             {"scenario": "b", "deadband": _brief(5.0, 7.0, -39.9), "as-specified": _brief(5.0, 6.9, -39.95)}]
+    text = "\n".join(hysteresis_findings(table))
+    assert "Reached before the change (dead band, 1 ms): 4 targets. Not reached after it at 1 ms: 1 (`a` move 2)" in text
+    assert "Of the 1 of these run at 0.1 ms, 1 are reached." in text
+    assert "at most 0.10 deg from -40 deg before the change, 1.30 deg after it at 1 ms, 0.15 deg at 0.1 ms" in text
+    assert "what the change broke at 1 ms is the step" in text
+    table[0]["dt0.1ms"] = _brief(5.0, None, -41.0)
+    text = "\n".join(hysteresis_findings(table))
+    assert "what the change broke" not in text and "1 of the 1 targets lost at 1 ms and run at 0.1 ms" in text
+
+
+def _cycle(key, reach, sched):
+    row = {"key": key, "reading": key, "short": key}
+    for kind, (i, c) in (("reach", reach), ("schedule", sched)):
+        row.update({f"{kind}_independent_s": i, f"{kind}_cooperative_s": c,
+                    f"{kind}_reduction": None if i is None or c is None else (i - c) / i})
+    return row
+
+
+def test_cycle_findings_follow_the_numbers():
+    from smafinger.paper.cycle_findings import cycle_findings
+
+    table = [_cycle("as-specified", (25.3, 14.7), (37.0, 23.9)), _cycle("enabled", (19.4, 14.7), (34.1, 23.9)),
+             _cycle("cdf-heating", (19.4, 14.7), (34.1, 23.9)), _cycle("cdf-cooling", (26.3, 57.3), (35.9, 22.8))]
+    text = "\n".join(cycle_findings(table))
+    # the issue's numbers: 24% with one C_DF, 42% with the switching; in seconds 4.7 of 10.6 s
+    assert "| 25.3 s / 14.7 s (42%); the authors' enable rule 19.4 s / 14.7 s (24%)"[2:] in text
+    assert ("Of the 10.6 s the co-operative cycle saves with the switching, 5.9 s (56%) come from the switching "
+            "itself: with one C_DF it saves 4.7 s.") in text
+    assert "The co-operative cycle is the same under the set's heating-phase switching" in text
+    assert "The enable rule gives exactly the one-C_DF times" in text
+    assert "Both cycle times within 20% of the paper's: as-specified on the 10 s schedule" in text
+    assert "Closest co-operative time to the paper's 27.5 s: 23.9 s (as-specified, on the 10 s schedule)" in text
+    table[2] = _cycle("cdf-heating", (19.4, 15.0), (34.1, 23.9))
+    assert "is the same under" not in "\n".join(cycle_findings(table)).split("on the 10 s schedule (independent")[0]
+
+
+def test_move_findings_pick_the_closest_definition():
+    from smafinger.paper.cycle_findings import move_findings
+
+    def row(strategy, end, times):
+        return {"variant": "as-specified", "variant_label": "as specified", "variant_short": "as specified",
+                "strategy": strategy, "end": end,
+                "ends": end, "moves_s": times, "paper_per_move_s": 0.0,
+                "mean_s": None if None in times else sum(times) / len(times)}
+
+    moves = [row("independent", "reached", [6.0, 7.0, 5.0, 7.0]), row("independent", "rest", [9.0, 9.5, 9.0, 9.9]),
+             row("cooperative", "reached", [6.0, 5.0, 4.0]), row("cooperative", "settled", [6.0, None, 6.0])]
+    text = "\n".join(move_findings(moves, [_cycle("as-specified", (None, None), (37.0, 23.9))]))
+    assert "Independent (paper: 9.38 s per move): closest mean 9.35 s (rest; as specified); 1 of 2" in text
+    assert "Co-operative (paper: 9.17 s per move): closest mean 5.00 s (reached; as specified); 0 of 1" in text
+    assert "37.5 = 3 x 10 + 7.5 and 27.5 = 2 x 10 + 7.5, the same 7.5 s last move for both" in text
+    assert "smafinger's last moves end 7.0 s and 3.9 s into their 10 s" in text

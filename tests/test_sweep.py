@@ -175,9 +175,17 @@ def test_sweep_table_and_rerun_is_idempotent(tmp_path):
     assert not sw.parts_dir(out).exists()
     df = pd.read_parquet(out)
     assert list(df.columns[:5]) == ["run_id", "point", "h0", "C_DF_heating_Nms", "status"]
-    for c in ("energy_upper_J", "peak_T_upper_C", "peak_stress_upper_Pa", "interlock_violations",
-              "seg0_reached_s", "seg0_overshoot_deg", "theta_max_deg", "motion_start_s"):
+    for c in ("electrical_energy_upper_J", "heat_upper_J", "peak_T_upper_C", "peak_stress_upper_Pa",
+              "electrical_energy_lower_J", "heat_lower_J", "interlock_violations", "seg0_reached_s",
+              "seg0_overshoot_deg", "theta_max_deg", "motion_start_s"):
         assert c in df.columns
+    # energy named for what it is: with Eq. (11) read per metre (the paper's sets) the electrical
+    # energy at the terminals is 1 / L_w^2 times the heat the model puts into the wire
+    L_w = load_spec(spec).runs()[0].spec.params.wire_length_m
+    assert np.allclose(df["electrical_energy_upper_J"], df["heat_upper_J"] / L_w**2, rtol=1e-9)
+    assert (df["heat_upper_J"] > 0).all() and (df["heat_lower_J"] == 0).all()
+    # the linear actuator's columns are there, and empty
+    assert df[["heat_wire_J", "position_max_m", "seg0_target_m"]].isna().all().all()
     assert df["point"].tolist() == list(range(6)) and df["run_id"].is_unique
     assert (df["status"] == "ok").all() and (df["interlock_violations"] == 0).all()
     assert df.loc[0, "run_id"] == load_spec(spec).runs()[0].run_id
@@ -259,7 +267,7 @@ def test_failed_runs_are_rows_and_count_as_done(tmp_path, monkeypatch):
     df = pd.read_parquet(out)
     assert rep.failed == 2 and (df["status"] == "error").sum() == 2
     bad = df[df["status"] == "error"]
-    assert (bad["C_DF_heating_Nms"] == 0.03).all() and bad["energy_upper_J"].isna().all()
+    assert (bad["C_DF_heating_Nms"] == 0.03).all() and bad["electrical_energy_upper_J"].isna().all()
     assert bad["error"].str.contains("SimulationError: numerical blow-up").all()
     assert set(pd.read_parquet(rep.traces_out)["run_id"]) == set(df.loc[df["status"] == "ok", "run_id"])
     rep2 = run_sweep(spec, out, workers=1, traces=True)  # deterministic failures are not redone
@@ -280,6 +288,29 @@ def test_traces_option(tmp_path):
     one = tr[tr["run_id"] == df.loc[0, "run_id"]]
     assert one["t_s"].tolist() == [0.0, 0.5, 1.0, 1.5, 2.0]
     assert np.isclose(one["theta_deg"].max(), df.loc[0, "theta_max_deg"], atol=0.5)
+
+
+def test_linear_actuator_sweep_has_its_own_columns(tmp_path):
+    """A sweep of the linear bias-spring rig: per-wire columns by its wire's name, its coordinate in metres."""
+    spec = parse_spec({"base": {"params": "linear-bias-spring", "strategy": "open-loop", "voltage": "0:12,2:0",
+                                "t_end_s": 4.0},
+                       "vary": {"bias_spring_K_N_m": [100.0, 400.0]}})
+    out = tmp_path / "lin.parquet"
+    rep = run_sweep(spec, out, workers=1, traces=True)
+    df = pd.read_parquet(out)
+    assert rep.failed == 0 and (df["status"] == "ok").all()
+    p = spec.runs()[0].spec.params
+    # 12 V at the terminals of the whole wire for 2 s: V^2 / (R_w L_w) t (the rig reads Eq. 11 whole-wire,
+    # so the heat the model puts into the wire is the same energy)
+    e = 12.0**2 / (p.resistance_ohm_per_m * p.wire_length_m) * 2.0
+    assert np.allclose(df["electrical_energy_wire_J"], e, rtol=1e-6) and np.allclose(df["heat_wire_J"], e, rtol=1e-6)
+    assert (df["position_max_m"] > 1e-4).all() and (df["motion_start_s"] > 0).all()
+    # a stiffer bias spring: a shorter stroke
+    assert df["position_max_m"].iloc[1] < df["position_max_m"].iloc[0]
+    assert df["seg0_target_m"].notna().all() and df["seg0_target_deg"].isna().all()
+    assert df[["electrical_energy_upper_J", "theta_max_deg"]].isna().all().all()
+    tr = pd.read_parquet(rep.traces_out)
+    assert tr["position_m"].notna().all() and tr["T_wire_C"].notna().all() and tr["theta_deg"].isna().all()
 
 
 def test_fig8_local_physics():

@@ -12,6 +12,11 @@ Conventions
 - Overshoot is measured in the direction of the motion: from where the joint was when the
   move started, towards the target and beyond it (:func:`overshoot_deg`).
 - ``None`` means "never" (a time that did not happen in the run).
+- Energy is named for what it is: ``electrical_energy_J`` is the energy at a wire's terminals
+  (V^2 / (R_w L_w) integrated, what a supply delivers), ``heat_J`` the heat the model's Eq. (11)
+  puts into the wire. With the paper's per-metre reading of Eq. (11) (``joule_heating =
+  per-metre``) the two differ by the factor 1 / L_w^2 (6.75 for the paper's 0.385 m wire).
+  ``energy_J`` is smafinger 0.1's name of the electrical energy, kept for compatibility.
 """
 
 from __future__ import annotations
@@ -36,8 +41,10 @@ STILL_WINDOW_S = 1.0
 SETTLE_BAND_DEG = 0.1
 #: a wire is back to martensite once its martensite fraction reaches this
 MARTENSITE_XI = 0.999
-#: cooling phase: the overshoot after it is looked for within this time [s]
+#: cooling phase: the fall back past the target after it is looked for within this time [s]
 COOLING_WINDOW_S = 5.0
+#: the joint is at rest once slower than this [deg/s]
+REST_SPEED_DEG_S = 0.05
 #: angle comparisons with a tolerance allow this much rounding [deg]
 ANGLE_EPS_DEG = 1e-12
 
@@ -83,6 +90,17 @@ def motion_start_s(t: np.ndarray, theta_deg: np.ndarray, threshold_deg: float = 
     return first_time(np.abs(theta_deg - ref) > threshold_deg, t)
 
 
+def _inside_from(ts: np.ndarray, outside: np.ndarray, start_s: float) -> float | None:
+    """Time from ``start_s`` after which ``outside`` stays false to the last sample ``ts``
+    (0 if never true; ``None`` if true at the last sample)."""
+    if not outside.any():
+        return 0.0
+    k = int(np.flatnonzero(outside)[-1])
+    if k == len(ts) - 1:
+        return None
+    return float(ts[k + 1] - start_s)
+
+
 def settle_time(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s: float,
                 end_s: float, band_deg: float = SETTLE_BAND_DEG) -> float | None:
     """Time from ``start_s`` after which ``|theta - target| <= band_deg`` until ``end_s``.
@@ -90,14 +108,17 @@ def settle_time(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s
     0 if always inside; ``None`` if the joint is still outside at ``end_s``.
     """
     m = window(t, start_s, end_s)
-    ts, th = t[m], theta_deg[m]
-    out = np.abs(th - target_deg) > band_deg
-    if not out.any():
-        return 0.0
-    k = int(np.flatnonzero(out)[-1])
-    if k == len(ts) - 1:
-        return None
-    return float(ts[k + 1] - start_s)
+    return _inside_from(t[m], np.abs(theta_deg[m] - target_deg) > band_deg, start_s)
+
+
+def rest_time(t: np.ndarray, speed: np.ndarray, start_s: float, end_s: float,
+              threshold: float = REST_SPEED_DEG_S) -> float | None:
+    """Time from ``start_s`` after which ``|speed| <= threshold`` until ``end_s`` (the joint at rest).
+
+    0 if it never moves faster; ``None`` if it is still moving at ``end_s``.
+    """
+    m = window(t, start_s, end_s)
+    return _inside_from(t[m], np.abs(speed[m]) > threshold, start_s)
 
 
 def time_to_reach(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s: float,
@@ -132,6 +153,31 @@ def martensite_time(t: np.ndarray, xi: np.ndarray, start_s: float,
     was = float(xi[m][0]) if m.any() else 1.0
     hit = first_time(m & (xi >= full_xi), t)
     return None if was >= full_xi or hit is None else hit - start_s
+
+
+def cooled_time(t: np.ndarray, xi: Mapping[str, np.ndarray], start_s: float, end_s: float,
+                full_xi: float = MARTENSITE_XI) -> float | None:
+    """Time from ``start_s`` until every wire that was partly austenite then is back to
+    martensite (the end of the cooling phases a move waits for, Sec. 4.1).
+
+    ``xi``: each wire's martensite fraction. 0 if every wire was martensite at ``start_s``;
+    ``None`` if one is not back by ``end_s``.
+    """
+    times = []
+    for x in xi.values():
+        m = window(t, start_s, end_s)
+        if not m.any() or float(x[m][0]) >= full_xi:
+            continue
+        back = martensite_time(t, np.where(m, x, 0.0), start_s, full_xi)
+        if back is None:
+            return None
+        times.append(back)
+    return max(times, default=0.0)
+
+
+def sample_at(t: np.ndarray, x: np.ndarray, at_s: float) -> float:
+    """``x`` at the first sample at or after ``at_s`` (the last sample if none)."""
+    return float(x[min(int(np.searchsorted(t, at_s - EDGE_S)), len(t) - 1)])
 
 
 def increase(t: np.ndarray, cumulative: np.ndarray, start_s: float, end_s: float) -> float:
@@ -186,16 +232,17 @@ def cooling_phase_metrics(t: np.ndarray, theta_deg: np.ndarray, T_agonist_C: np.
                           target_deg: float, window_s: float = COOLING_WINDOW_S) -> dict:
     """The agonist's first cooling phase: the joint past ``target_deg`` (Sec. 2.6, Fig. 11).
 
-    "Past" is in the direction of the motion from the first sample. Returned: the phase's
-    ``cooling_start_s`` and duration ``cooling_s``, the mean fall of the agonist's
-    temperature over it ``cooling_rate_C_s``, ``peak_past_deg`` (the overshoot before it
-    ends) and ``overshoot_after_deg`` (the overshoot back the other way within
-    ``window_s`` after it ends). ``None`` values when the joint never passes the target.
+    The move is from the first sample towards ``target_deg``; "past" is in its direction.
+    Returned: ``overshoot_deg``, the move's overshoot (:func:`overshoot_deg`, the one
+    definition: how far the joint goes past the target in the direction of the move); the
+    first cooling phase's ``cooling_start_s`` and duration ``cooling_s``, the mean fall of the
+    agonist's temperature over it ``cooling_rate_C_s``; and ``fall_back_deg``, how far the
+    joint then falls back past the target, against the move's direction, within ``window_s``
+    after the phase ends. ``None`` values when the joint never passes the target.
     """
     direction = motion_direction(float(theta_deg[0]), target_deg)
-    out: dict = {"cooling_start_s": None, "cooling_s": None, "cooling_rate_C_s": None,
-                 "peak_past_deg": overshoot_deg(theta_deg, target_deg, direction),
-                 "overshoot_after_deg": None}
+    out: dict = {"overshoot_deg": overshoot_deg(theta_deg, target_deg, direction), "cooling_start_s": None,
+                 "cooling_s": None, "cooling_rate_C_s": None, "fall_back_deg": None}
     past = direction * (theta_deg - target_deg) > 0
     if direction == 0 or not past.any():
         return out
@@ -206,9 +253,41 @@ def cooling_phase_metrics(t: np.ndarray, theta_deg: np.ndarray, T_agonist_C: np.
     after = window(t, float(t[i1]), float(t[i1]) + window_s)
     out.update(cooling_start_s=float(t[i0]), cooling_s=dur,
                cooling_rate_C_s=float((T_agonist_C[i0] - T_agonist_C[i1]) / dur) if dur > 0 else None,
-               peak_past_deg=overshoot_deg(theta_deg[i0:i1 + 1], target_deg, direction),
-               overshoot_after_deg=(overshoot_deg(theta_deg[after], target_deg, -direction)
-                                    if back.size else None))
+               fall_back_deg=(overshoot_deg(theta_deg[after], target_deg, -direction) if back.size else None))
+    return out
+
+
+def onoff_cycle_metrics(t: np.ndarray, theta_deg: np.ndarray, T_wire_C: np.ndarray, T_casing_C: np.ndarray,
+                        xi: np.ndarray, on_s: Sequence[tuple[float, float]],
+                        fraction: float = WAY_FRACTION) -> list[dict]:
+    """Open-loop on/off cycles (Sec. 3.2, Fig. 10a): one dict per ``(on, off)`` interval.
+
+    A cycle runs from its ``on`` time to the next cycle's (the last one to the end of the run).
+    Returned per cycle: ``on_s``, ``off_s``, ``end_s``; the casing temperature at the start, at
+    the switch-off and at the end of the cool-down (``casing_start_C``, ``casing_off_C``,
+    ``casing_end_C``); the wire's peak and end temperatures; ``range_deg`` (largest move from
+    the cycle's starting angle while heated); ``cooling_s``, the cooling time of the move: from
+    the switch-off until the joint has come back ``fraction`` of the way to the cycle's starting
+    angle (``None`` if not within the cool-down); and ``martensite_s``, from the switch-off until
+    the wire is back to martensite (``None`` if not within the cool-down).
+    """
+    out = []
+    for k, (on, off) in enumerate(on_s):
+        end = on_s[k + 1][0] if k + 1 < len(on_s) else float(t[-1])
+        th0, th_off = sample_at(t, theta_deg, on), sample_at(t, theta_deg, off)
+        heat, cool = window(t, on, off), window(t, off, end)
+        way = abs(th_off - th0)
+        back = first_time(cool & (np.abs(theta_deg - th0) <= (1.0 - fraction) * way), t) if way > 0 else None
+        mart = martensite_time(t, np.where(cool, xi, 0.0), off)
+        out.append({
+            "on_s": on, "off_s": off, "end_s": end,
+            "casing_start_C": sample_at(t, T_casing_C, on), "casing_off_C": sample_at(t, T_casing_C, off),
+            "casing_end_C": sample_at(t, T_casing_C, end),
+            "wire_peak_C": float(np.max(T_wire_C[heat])), "wire_end_C": sample_at(t, T_wire_C, end),
+            "range_deg": float(np.max(np.abs(theta_deg[heat] - th0))),
+            "cooling_s": None if back is None else back - off,
+            "martensite_s": mart,
+        })
     return out
 
 
@@ -232,9 +311,13 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
                     temperature_C: Mapping[str, np.ndarray], energy_J: Mapping[str, np.ndarray],
                     unit: str = "deg", heat_J: Mapping[str, np.ndarray] | None = None) -> dict:
     """A segment's reach time, overshoot (in the direction of its move), energy and peak
-    temperature per wire (``energy_J`` are cumulative signals). ``q`` is the joint angle [deg]
-    or a slider's position [m]; ``unit`` names the keys (``target_deg``, ``overshoot_m``)."""
+    temperature per wire. ``energy_J`` (cumulative electrical energy at each wire's terminals)
+    and ``heat_J`` (cumulative heat the model puts into each wire) are signals; the segment's
+    electrical energy is given as ``electrical_energy_J`` (and as ``energy_J``, its 0.1 name),
+    its heat as ``heat_J``. ``q`` is the joint angle [deg] or a slider's position [m]; ``unit``
+    names the keys (``target_deg``, ``overshoot_m``)."""
     m = window(t, span.start_s, span.end_s)
+    electrical = {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()}
     k0 = int(np.searchsorted(t, span.start_s - EDGE_S))
     direction = motion_direction(float(q[k0]), span.target)
     return {
@@ -245,7 +328,8 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         "enable": span.enable,
         "reached_s": span.reached_s,
         f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
-        "energy_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()},
+        "energy_J": electrical,
+        "electrical_energy_J": electrical,
         **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in heat_J.items()}}
            if heat_J is not None else {}),
         "peak_temperature_C": {w: float(np.max(T[m])) for w, T in temperature_C.items()},
@@ -306,8 +390,9 @@ def reduction(slower_s: float | None, faster_s: float | None) -> float | None:
 
 __all__ = [
     "EDGE_S", "START_OF_MOTION_DEG", "WAY_FRACTION", "STILL_WINDOW_S", "SETTLE_BAND_DEG",
-    "MARTENSITE_XI", "COOLING_WINDOW_S", "window", "first_time", "motion_direction",
-    "overshoot_deg", "motion_start_s", "settle_time", "time_to_reach", "martensite_time",
-    "increase", "openloop_metrics", "cooling_phase_metrics", "Span", "segment_metrics",
+    "MARTENSITE_XI", "COOLING_WINDOW_S", "REST_SPEED_DEG_S", "window", "first_time", "motion_direction",
+    "overshoot_deg", "motion_start_s", "settle_time", "rest_time", "time_to_reach", "martensite_time",
+    "cooled_time", "sample_at", "increase", "openloop_metrics", "cooling_phase_metrics",
+    "onoff_cycle_metrics", "Span", "segment_metrics",
     "run_metrics", "elapsed_time", "cycle_time", "reached_sum", "reduction",
 ]

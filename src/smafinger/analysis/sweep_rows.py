@@ -4,6 +4,14 @@ Both functions take the sweep's :class:`~smafinger.analysis.sweep_spec.SweepTemp
 the varied values of their points as columns, build each run's spec there (validation
 happens in the workers, in parallel) and send back only small things: run ids, or the
 table rows and the decimated float32 traces.
+
+The columns follow each mechanism's coordinate and wire names (``theta_max_deg`` and
+``heat_upper_J`` for the finger joint, ``position_max_m`` and ``heat_wire_J`` for the linear
+actuator). One table schema serves every sweep: it lists the columns of every mechanism of
+:data:`~smafinger.parameters.MECHANISMS`, and a run fills those of its own mechanism (the
+others stay empty). Energy is named for what it is (:mod:`smafinger.metrics`):
+``electrical_energy_{wire}_J`` at the wire's terminals, ``heat_{wire}_J`` what the model's
+Eq. (11) puts into the wire.
 """
 
 from __future__ import annotations
@@ -13,58 +21,95 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.batch import compact_signals, warm_up
+from ..engine.batch import FLOAT64_SIGNALS, warm_up
 from ..engine.run import run_spec
+from ..engine.signals import COORDINATE_NAMES
+from ..parameters import MECHANISMS
 from .sweep_spec import SPEC_ERRORS, SweepTemplate, run_id
 
 #: the joint has started to move once it is this far from its initial angle
 MOTION_THRESHOLD_DEG = 0.5
+#: the slider has started to move once it is this far from its start position [m]
+MOTION_THRESHOLD_M = 0.1e-3
+#: the motion threshold in each coordinate unit
+MOTION_THRESHOLDS = {"deg": MOTION_THRESHOLD_DEG, "m": MOTION_THRESHOLD_M}
+#: per-wire metric columns, ``{wire}`` replaced by each wire's name
+WIRE_METRICS = ("electrical_energy_{wire}_J", "heat_{wire}_J", "peak_T_{wire}_C", "peak_stress_{wire}_Pa")
+#: per-coordinate metric columns, ``{q}`` replaced by the coordinate's name, ``{unit}`` by its unit
+COORDINATE_METRICS = ("{q}_max_{unit}", "{q}_min_{unit}", "{q}_final_{unit}")
+#: per-wire trace columns
+WIRE_TRACES = ("T_{wire}_C", "xi_{wire}", "sigma_{wire}_Pa", "V_{wire}_V", "duty_{wire}")
+
+
+def _unique(items) -> tuple:
+    return tuple(dict.fromkeys(items))
+
+
+#: every mechanism's wire names and coordinates (name, unit), in registry order
+WIRE_NAMES = _unique(w for cls in MECHANISMS.values() for w in cls.wire_names)
+COORDINATES = _unique((cls.coordinate.name, cls.coordinate.unit) for cls in MECHANISMS.values())
+UNITS = _unique(unit for _, unit in COORDINATES)
 #: per-run metric columns, in table order (then the per-segment ``seg{i}_*`` columns)
 METRIC_COLUMNS = (
-    "status", "error", "energy_upper_J", "energy_lower_J", "peak_T_upper_C", "peak_T_lower_C",
-    "peak_stress_upper_Pa", "peak_stress_lower_Pa", "interlock_violations", "theta_max_deg",
-    "theta_min_deg", "theta_final_deg", "motion_start_s", "steps", "wall_s",
+    "status", "error",
+    *(c.format(wire=w) for w in WIRE_NAMES for c in WIRE_METRICS),
+    "interlock_violations",
+    *(c.format(q=q, unit=u) for q, u in COORDINATES for c in COORDINATE_METRICS),
+    "motion_start_s", "steps", "wall_s",
 )
 INT_COLUMNS = ("interlock_violations", "steps")
-SEGMENT_COLUMNS = ("target_deg", "start_s", "reached_s", "overshoot_deg")
-TRACE_COLUMNS = ("t_s", "theta_deg", "theta_ref_deg", "omega_deg_s", "T_upper_C", "T_lower_C",
-                 "xi_upper", "xi_lower", "sigma_upper_Pa", "sigma_lower_Pa", "V_upper_V",
-                 "V_lower_V", "duty_upper", "duty_lower")
+#: per-segment columns: target, start, reach time and overshoot (target and overshoot in every unit)
+SEGMENT_COLUMNS = (f"target_{UNITS[0]}", "start_s", "reached_s", f"overshoot_{UNITS[0]}",
+                   *(f"{c}_{u}" for u in UNITS[1:] for c in ("target", "overshoot")))
+TRACE_COLUMNS = ("t_s", *_unique(COORDINATE_NAMES[m][k] for m in MECHANISMS for k in ("q", "q_ref", "v")),
+                 *(c.format(wire=w) for c in WIRE_TRACES for w in WIRE_NAMES))
 
 
 def metrics_row(result, traces_interval_s: float | None = None) -> dict:
     """The table row (metrics) of one run; with ``traces_interval_s`` also its sampled trace
-    (float32 but time, :func:`~smafinger.engine.batch.compact_signals`) under the key
-    ``"_trace"``. Runs in the worker (picklable, module level)."""
+    (float32 but time; NaN for the columns of other mechanisms) under the key ``"_trace"``.
+    Runs in the worker (picklable, module level)."""
     s = result.summary()
-    th = np.asarray(result.signal("theta_deg"))
+    p = result.spec.params
+    q, unit = p.coordinate.name, p.coordinate.unit
+    x = np.asarray(result.signal(f"{q}_{unit}"))
     t = np.asarray(result.signal("t_s"))
-    moved = np.flatnonzero(np.abs(th - th[0]) > MOTION_THRESHOLD_DEG)
-    row = {
-        "status": "ok", "error": "",
-        "energy_upper_J": s["energy_J"]["upper"], "energy_lower_J": s["energy_J"]["lower"],
-        "peak_T_upper_C": s["peak_temperature_C"]["upper"],
-        "peak_T_lower_C": s["peak_temperature_C"]["lower"],
-        "peak_stress_upper_Pa": s["peak_stress_Pa"]["upper"],
-        "peak_stress_lower_Pa": s["peak_stress_Pa"]["lower"],
+    moved = np.flatnonzero(np.abs(x - x[0]) > MOTION_THRESHOLDS[unit])
+    per_wire = {"electrical_energy_{wire}_J": s["electrical_energy_J"], "heat_{wire}_J": s["heat_J"],
+                "peak_T_{wire}_C": s["peak_temperature_C"], "peak_stress_{wire}_Pa": s["peak_stress_Pa"]}
+    row = {"status": "ok", "error": ""}
+    row.update({c.format(wire=w): float(v[w]) for c, v in per_wire.items() for w in p.wire_names})
+    row.update({
         "interlock_violations": int(s["interlock_violations"]),
-        "theta_max_deg": float(np.max(th)), "theta_min_deg": float(np.min(th)),
-        "theta_final_deg": float(th[-1]),
+        f"{q}_max_{unit}": float(np.max(x)), f"{q}_min_{unit}": float(np.min(x)), f"{q}_final_{unit}": float(x[-1]),
         "motion_start_s": float(t[moved[0]]) if moved.size else math.nan,
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
-    }
+    })
     segs = {seg["index"]: seg for seg in s["segments"]}
     for i, seg_def in enumerate(result.spec.profile.segments):
         seg = segs.get(i)
-        row[f"seg{i}_target_deg"] = float(seg_def.target_deg)
+        row[f"seg{i}_target_{unit}"] = float(seg_def.target)
         row[f"seg{i}_start_s"] = float(seg["start_s"]) if seg else math.nan
         reached = seg["reached_s"] if seg else None
         row[f"seg{i}_reached_s"] = math.nan if reached is None else float(reached)
-        row[f"seg{i}_overshoot_deg"] = float(seg["overshoot_deg"]) if seg else math.nan
+        row[f"seg{i}_overshoot_{unit}"] = float(seg[f"overshoot_{unit}"]) if seg else math.nan
     if traces_interval_s:
         step = max(1, round(traces_interval_s / result.spec.output_interval_s))
-        row["_trace"] = compact_signals(result, TRACE_COLUMNS, step)
+        row["_trace"] = trace(result, step)
     return row
+
+
+def trace(result, every: int) -> dict[str, np.ndarray]:
+    """Every :data:`TRACE_COLUMNS` signal of a run, every ``every``-th sample, float32 but
+    time; the columns the run's mechanism does not have are NaN."""
+    have = set(result.column_names)
+    n = len(result.t[::every])
+    out = {}
+    for c in TRACE_COLUMNS:
+        dtype = np.float64 if c in FLOAT64_SIGNALS else np.float32
+        out[c] = (np.ascontiguousarray(np.asarray(result.signal(c))[::every], dtype=dtype) if c in have
+                  else np.full(n, np.nan, dtype=dtype))
+    return out
 
 
 def error_row(exc: BaseException) -> dict:

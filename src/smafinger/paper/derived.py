@@ -30,15 +30,23 @@ def cycle_metrics(result: SimulationResult) -> dict:
 
 
 def segment_detail(result: SimulationResult, index: int) -> dict:
-    """A segment's target, start, reach time and overshoot (from the run's metrics), its
-    settling time, when each wire got back to martensite, and each wire's peak duty."""
+    """A segment's target, start, end, reach time and overshoot (from the run's metrics); its
+    settling time (:func:`~smafinger.metrics.settle_time`), when the joint comes to rest
+    (:func:`~smafinger.metrics.rest_time`), when the wires it started with partly austenite are
+    back to martensite (``cooled_s``, :func:`~smafinger.metrics.cooled_time`), the angle at its
+    end; and per wire when it got back to martensite and its peak duty."""
     seg = next(s for s in result.summary()["segments"] if s["index"] == index)
     t, th = result.t, result.signal("theta_deg")
-    inside = M.window(t, seg["start_s"], seg["end_s"])
-    out = {k: seg[k] for k in ("target_deg", "start_s", "reached_s", "overshoot_deg")}
-    out["settle_s"] = M.settle_time(t, th, seg["target_deg"], seg["start_s"], seg["end_s"])
+    a, b = seg["start_s"], seg["end_s"]
+    inside = M.window(t, a, b)
+    xi = {w: result.signal(f"xi_{w}") for w in WIRES}
+    out = {k: seg[k] for k in ("target_deg", "start_s", "end_s", "reached_s", "overshoot_deg")}
+    out["settle_s"] = M.settle_time(t, th, seg["target_deg"], a, b)
+    out["rest_s"] = M.rest_time(t, result.signal("omega_deg_s"), a, b)
+    out["cooled_s"] = M.cooled_time(t, xi, a, b)
+    out["final_deg"] = float(th[inside][-1])
     for w in WIRES:
-        out[f"martensite_{w}_s"] = M.martensite_time(t, result.signal(f"xi_{w}"), seg["start_s"])
+        out[f"martensite_{w}_s"] = M.martensite_time(t, xi[w], a)
         out[f"peak_duty_{w}"] = float(result.signal(f"duty_{w}")[inside].max())
     return out
 
@@ -56,10 +64,27 @@ class OpenLoop:
 
 @dataclass(frozen=True)
 class Cycle:
-    """Closed loop: the cycle times (:func:`cycle_metrics`)."""
+    """Closed loop: the cycle times (:func:`cycle_metrics`) and every segment that started,
+    in detail (``moves``: :func:`segment_detail` of each)."""
 
     def compute(self, result: SimulationResult) -> dict:
-        return cycle_metrics(result)
+        moves = [segment_detail(result, s["index"]) for s in result.summary()["segments"]]
+        return {**cycle_metrics(result), "moves": moves}
+
+
+@dataclass(frozen=True)
+class OnOffCycles:
+    """Open loop, ``wire`` switched on and off (Sec. 3.2, Fig. 10a): the cycles of
+    :func:`~smafinger.metrics.onoff_cycle_metrics` (``cycles``), ``on_s`` the (on, off) times."""
+
+    on_s: tuple[tuple[float, float], ...]
+    wire: str = "upper"
+
+    def compute(self, result: SimulationResult) -> dict:
+        w = self.wire
+        return {"cycles": M.onoff_cycle_metrics(
+            result.t, result.signal("theta_deg"), result.signal(f"T_{w}_C"), result.signal(f"T_casing_{w}_C"),
+            result.signal(f"xi_{w}"), self.on_s)}
 
 
 @dataclass(frozen=True)
@@ -88,7 +113,7 @@ class CoolingPhase:
         return {**cycle_metrics(result), "cooling_phase": cp}
 
 
-Derivation = Union[OpenLoop, Cycle, MoveAndReturn, CoolingPhase]
+Derivation = Union[OpenLoop, Cycle, MoveAndReturn, CoolingPhase, OnOffCycles]
 
 
 @dataclass
@@ -117,5 +142,5 @@ def derive(derivation: Derivation | None, result: SimulationResult) -> dict:
     return {} if derivation is None else derivation.compute(result)
 
 
-__all__ = ["OpenLoop", "Cycle", "MoveAndReturn", "CoolingPhase", "Derivation", "Run", "derive",
+__all__ = ["OpenLoop", "Cycle", "MoveAndReturn", "CoolingPhase", "OnOffCycles", "Derivation", "Run", "derive",
            "cycle_metrics", "segment_detail"]

@@ -79,9 +79,14 @@ def openloop(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
-def cooling_phase(runs: list, title: str, path: Path, panel: str, zoom_deg: float | None = None) -> None:
-    """Fig. 11: the angle (and, with ``zoom_deg``, a close-up of +-zoom_deg around the
-    target) and the agonist's temperature, controller on vs off in its cooling phase."""
+def cooling_phase(runs: list, title: str, path: Path, panel: str, zoom_deg: float | None = None,
+                  marks=None) -> None:
+    """Fig. 11: the angle (and, with ``zoom_deg``, a close-up of +-zoom_deg around the last
+    target) and the agonist's temperature, controller on vs off in its cooling phase.
+
+    ``marks(run) -> (target_deg, direction, overshoot_deg)``: the overshoot the claim reads
+    (in the direction of the move), drawn as a dotted level in the run's colour.
+    """
     plt = _plt()
     rows = 3 if zoom_deg else 2
     fig, ax = plt.subplots(rows, 1, figsize=(7.5, 3.2 * rows + 0.6), sharex=True, constrained_layout=True)
@@ -95,16 +100,57 @@ def cooling_phase(runs: list, title: str, path: Path, panel: str, zoom_deg: floa
             target = float(res.signal("theta_ref_deg")[-1])
         for a in angle_axes:
             a.plot(res.t, res.signal("theta_deg"), color=c, ls=ls, label=r.scenario.label)
+        if marks is not None:
+            aim, direction, ov = marks(r)
+            angle_axes[-1].axhline(aim + direction * ov, color=c, ls=":", lw=1.2,
+                                   label=f"{r.scenario.label}: overshoot {ov:.3f} deg")
         ax[-1].plot(res.t, res.signal(f"T_{r.scenario.wire}_C"), color=c, ls=ls, label=r.scenario.label)
     ax[0].set_ylabel(r"Joint angle $\theta$ [deg]")
     ax[0].set_title(panel)
     if zoom_deg and target is not None:
         ax[1].set_ylim(target - zoom_deg, target + zoom_deg)
         ax[1].set_ylabel(r"Joint angle $\theta$ [deg]")
-        ax[1].set_title(f"(b) Close-up: within {zoom_deg:g} deg of the target")
+        ax[1].set_title(f"(b) Close-up, +-{zoom_deg:g} deg" + ("; dotted: overshoot in the direction of the move"
+                                                               if marks else ""))
     ax[-1].set_ylabel("Agonist wire temperature [°C]")
     ax[-1].set_xlabel("Time [s]")
     ax[-1].set_title(f"({'c' if zoom_deg else 'b'}) Agonist wire temperature")
+    _legends(ax)
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def onoff_cycles(runs: list, title: str, path: Path) -> None:
+    """Fig. 10(a): open-loop on/off cycles. (a) the air inside the casing (two-node model),
+    (b) the wire's temperature, (c) the joint angle, (d) the cooling time of each cycle's move,
+    per thermal model."""
+    plt = _plt()
+    fig, ax = plt.subplots(4, 1, figsize=(8.0, 12.0), constrained_layout=True)
+    ok = [r for r in runs if r.ok]
+    for k, r in enumerate(ok):
+        res, (c, ls), w = r.result, STYLES[k % len(STYLES)], r.scenario.wire
+        cyc = r.derived["cycles"]
+        if r.spec.params.thermal_model == "two-node":
+            ax[0].plot(res.t, res.signal(f"T_casing_{w}_C"), color=c, lw=1.6, label=r.scenario.label)
+            ax[0].axhline(r.spec.params.T_amb_C, color="k", ls="--", lw=0.8, label="open air (ambient)")
+        ax[1].plot(res.t, res.signal(f"T_{w}_C"), color=c, ls=ls, lw=1.0, label=r.scenario.label)
+        ax[2].plot(res.t, res.signal("theta_deg"), color=c, ls=ls, label=r.scenario.label)
+        cool = [np.nan if x["cooling_s"] is None else x["cooling_s"] for x in cyc]
+        ax[3].plot(np.arange(1, len(cyc) + 1), cool, color=c, ls=ls, marker="o", label=r.scenario.label)
+        if k == 0:
+            for a in ax[:3]:
+                for x in cyc:
+                    a.axvspan(x["on_s"], x["off_s"], color="tab:orange", alpha=0.08)
+    titles = ("(a) Air inside the actuator casing (shaded: voltage on)", "(b) Wire temperature",
+              "(c) Joint angle", "(d) Cooling time of each move: 90% of the way back after the switch-off")
+    for a, t, y in zip(ax, titles, ("Temperature [°C]", "Temperature [°C]", r"Joint angle $\theta$ [deg]",
+                                    "Cooling time [s]")):
+        a.set_title(t)
+        a.set_ylabel(y)
+    for a in ax[:3]:
+        a.set_xlabel("Time [s]")
+    ax[3].set_xlabel("Cycle")
+    ax[3].set_xticks(np.arange(1, 1 + max((len(r.derived["cycles"]) for r in ok), default=0)))
     _legends(ax)
     fig.suptitle(title)
     _save(fig, path)
@@ -161,21 +207,25 @@ def returns(runs: list, title: str, path: Path) -> None:
 def cycles(runs: list, title: str, path: Path, panels: dict[str, str], paper_s: dict[str, float]) -> None:
     """Fig. 15: full cycles, one panel per reading (``panels``: panel -> title). Dashed: the
     time at which each run reaches its last target (``elapsed_s``, given in the legend with
-    the cycle time); dotted: the paper's cycle times ``paper_s`` (strategy -> s)."""
+    the cycle time); dotted: the paper's cycle times ``paper_s`` (strategy -> s). A second
+    run of the same strategy in a panel (an earlier reading) is drawn thin and dashed."""
     plt = _plt()
-    fig, ax = plt.subplots(len(panels), 1, figsize=(8.5, 3.75 * len(panels)), constrained_layout=True)
+    fig, ax = plt.subplots(len(panels), 1, figsize=(9.0, 5.2 * len(panels)), constrained_layout=True)
     ax = np.atleast_1d(ax)
     for row, (sel, panel_title) in enumerate(zip(_panels(runs, tuple(panels)), panels.values())):
         t_max = 0.0
-        for r in sel:
+        for i, r in enumerate(sel):
             res, c = r.result, STRATEGY_COLORS[r.spec.strategy]
+            first = r.spec.strategy not in {x.spec.strategy for x in sel[:i]}
             end, cyc = r.derived["elapsed_s"], r.derived["cycle_s"]
             lab = r.scenario.label + (": cycle not completed" if end is None else
                                       f": last target reached at t = {end:.1f} s (cycle time {cyc:.1f} s)")
-            ax[row].plot(res.t, res.signal("theta_ref_deg"), color=c, ls=":", lw=1.0)
-            ax[row].plot(res.t, res.signal("theta_deg"), color=c, label=lab)
+            if first:
+                ax[row].plot(res.t, res.signal("theta_ref_deg"), color=c, ls=":", lw=1.0)
+            ax[row].plot(res.t, res.signal("theta_deg"), color=c, label=lab,
+                         **({} if first else {"ls": "--", "lw": 0.8, "alpha": 0.7}))
             if end is not None:
-                ax[row].axvline(end, color=c, ls="--", lw=0.8)
+                ax[row].axvline(end, color=c, ls="--", lw=0.8, alpha=1.0 if first else 0.5)
                 t_max = max(t_max, end)
         for strat, v in paper_s.items():
             ax[row].axvline(v, color=STRATEGY_COLORS[strat], ls=(0, (1, 3)), lw=1.5, alpha=0.6)
@@ -183,11 +233,12 @@ def cycles(runs: list, title: str, path: Path, panels: dict[str, str], paper_s: 
         ax[row].plot([], [], color="gray", ls="--", lw=0.8, label="last target reached (smafinger)")
         ax[row].plot([], [], color="gray", ls=(0, (1, 3)), lw=1.5,
                      label="cycle end in the paper (" + " / ".join(f"{v:g}" for v in paper_s.values()) + " s)")
-        ax[row].set_xlim(0, max(40.0, t_max + 2.0, *paper_s.values()))
+        unfinished = [r.spec.t_end_s for r in sel if r.derived["elapsed_s"] is None]
+        ax[row].set_xlim(0, max(40.0, t_max + 2.0, *paper_s.values(), *unfinished))
         ax[row].set_title(panel_title)
         ax[row].set_xlabel("Time [s]")
         ax[row].set_ylabel(r"Joint angle $\theta$ [deg]")
-        ax[row].legend(loc="upper right", ncol=1)
+        ax[row].legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=7)
     fig.suptitle(title)
     _save(fig, path)
 
@@ -211,4 +262,4 @@ def profiles(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
-__all__ = ["openloop", "cooling_phase", "moves", "returns", "cycles", "profiles"]
+__all__ = ["openloop", "cooling_phase", "onoff_cycles", "moves", "returns", "cycles", "profiles"]

@@ -1,5 +1,7 @@
-"""The Fig. 15 full-cycle investigation: readings of the paper, each a change from the
-on-reach baseline, as typed data.
+"""The Fig. 15 full-cycle investigation of smafinger 0.1: readings of the paper, each a change
+from the v1 on-reach baseline (whose independent strategy uses the antagonist once the agonist's
+wire is back to martensite), as typed data. The faithful runs, the damping rules and the
+readings of the co-operative time are in :mod:`.cycle_study`.
 
 A :class:`Reading` changes the Fig. 15 on-reach scenarios (``fig15-*-v1``) with
 :class:`~.overrides.Overrides` per strategy; ``cooperative = None`` means the reading only
@@ -11,15 +13,18 @@ entry in :data:`READINGS`.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Iterable
 
 from ..engine.run import RunSpec
 from ..metrics import reduction
-from .derived import Cycle, Run
-from .fig15 import REACH, SCHEDULE_T_END_S, TARGETS, on_reach, scheduled
+from . import studies
+from .derived import Cycle, Derivation, Run
+from .fig15 import REACH_V1 as REACH
+from .fig15 import SCHEDULE_T_END_S, TARGETS, on_reach, scheduled
 from .overrides import Overrides
 from .scenario import MOVE_S
 from .scenarios import get
-from .sec4 import FIG11_WARM_C
+from .fig11 import WARM_C
 
 #: simulated time of the investigation's runs [s]
 T_END_S = 80.0
@@ -66,11 +71,11 @@ READINGS: tuple[Reading, ...] = (
             "is used (Sec. 4.1's sequence " + ", ".join(f"{t:g}" for t in TARGETS["independent"]) + ")",
             "once the joint is back at the rest position (Sec. 4.1's sequence)", "wait",
             Overrides.of(profile=on_reach(TARGETS["independent"])), None),
-    _both("Tinit60", f"initial wire temperature {FIG11_WARM_C:g} degC (ambient {_BASE.params.T_amb_C:g} degC)",
-          f"wires starting at {FIG11_WARM_C:g} degC", "temperature", T_init_C=FIG11_WARM_C),
-    _both("Tamb60", f"initial and ambient temperature {FIG11_WARM_C:g} degC (the authors' 2020 model)",
-          f"ambient and initial {FIG11_WARM_C:g} degC (the authors' 2020 model)", "temperature",
-          T_init_C=FIG11_WARM_C, T_amb_C=FIG11_WARM_C),
+    _both("Tinit60", f"initial wire temperature {WARM_C:g} degC (ambient {_BASE.params.T_amb_C:g} degC)",
+          f"wires starting at {WARM_C:g} degC", "temperature", T_init_C=WARM_C),
+    _both("Tamb60", f"initial and ambient temperature {WARM_C:g} degC (the authors' 2020 model)",
+          f"ambient and initial {WARM_C:g} degC (the authors' 2020 model)", "temperature",
+          T_init_C=WARM_C, T_amb_C=WARM_C),
     _both("update0", f"controller updated at every step instead of every {_BASE.params.controller_update_s:g} s",
           "continuous update", "controller", controller_update_s=0.0),
     _both("coolingoff", "controller switched off in the cooling phase", "controller off in cooling", "controller",
@@ -78,7 +83,7 @@ READINGS: tuple[Reading, ...] = (
     _both("antiwindup", "anti-windup (conditional integration)", "anti-windup", "controller", anti_windup="clamp"),
     _both("intnever", "error integral never reset (the authors' 2020 model)", "integral never reset",
           "controller", integral_reset="never"),
-    _both("restick", "friction: the joint re-sticks whenever it stops (paper2010 set's default)",
+    _both("restick", "friction: the joint re-sticks whenever it stops (smafinger 0.1's default for paper2010)",
           "re-sticking friction", "controller", friction_sticking="restick"),
     _both("sched-direct", f"time schedule, one move every {MOVE_S:g} s; independent goes "
           f"{TARGETS['cooperative'][0]:g} -> {TARGETS['cooperative'][1]:g} directly (engine's wait for the "
@@ -113,10 +118,23 @@ def spec(rd: Reading, strategy: str) -> RunSpec:
     return get(REACH[strategy]).spec(Overrides.of(t_end_s=T_END_S).then(ov))
 
 
-def tasks() -> list[tuple[str, RunSpec]]:
-    """``(key, spec)`` of every run of the investigation."""
+def reading_tasks() -> list[tuple[str, RunSpec]]:
+    """``(key, spec)`` of every run of the v1 readings."""
     return [(run_key(rd, k), spec(rd, k)) for rd in READINGS for k in ("independent", "cooperative")
             if k == "independent" or rd.cooperative is not None]
+
+
+def tasks(names: Iterable[str] | None = None) -> list[tuple[str, RunSpec]]:
+    """``(key, spec)`` of every run of the investigation: the v1 readings and the studies'
+    variants (:mod:`.studies`; of the scenarios ``names`` only, if given)."""
+    return reading_tasks() + studies.tasks(names)
+
+
+def derivations() -> dict[str, Derivation | None]:
+    """The figure metrics of every investigation run, by key."""
+    out: dict[str, Derivation | None] = {k: DERIVE for k, _ in reading_tasks()}
+    out.update(studies.derivations())
+    return out
 
 
 def table(runs: dict[str, Run]) -> list[dict]:
@@ -141,4 +159,5 @@ def table(runs: dict[str, Run]) -> list[dict]:
     return rows
 
 
-__all__ = ["Reading", "READINGS", "T_END_S", "DERIVE", "reading", "run_key", "spec", "tasks", "table"]
+__all__ = ["Reading", "READINGS", "T_END_S", "DERIVE", "reading", "run_key", "spec", "reading_tasks", "tasks",
+           "derivations", "table"]

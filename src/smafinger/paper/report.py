@@ -1,6 +1,9 @@
-"""``report.md``: each claim beside smafinger's value and verdict, the Fig. 15 investigation
-with its computed findings, and the runs. The narrative behind the readings is in
-``docs/reproduce.md``; every number and comparison here is computed from the runs."""
+"""``report.md``: each claim beside smafinger's value and verdict; the studies (issue 10's
+hysteresis change, the Fig. 15 cycles under each damping rule and reading, the time a move
+takes) and smafinger 0.1's Fig. 15 investigation, with their computed findings; and the runs,
+with the heat put into each wire and the electrical energy at its terminals. The narrative
+behind the readings is in ``docs/reproduce.md``; every number and comparison here is computed
+from the runs."""
 
 from __future__ import annotations
 
@@ -11,9 +14,10 @@ from ..parameters import get as get_params
 from ..results import atomic_write
 from .claim import Outcome, Verdict
 from .derived import Run
-from .fig15 import PAPER_REDUCTION, PAPER_S, REACH
+from .fig15 import PAPER_REDUCTION, PAPER_S, REACH, REACH_V1
 from .findings import findings
 from .fmt import md_escape, num, pct, secs
+from .issue10 import cycle_section, energy_note, hysteresis_section
 from .scenario import OPEN_LOOP_ON_S, PAPER_FRICTION
 from .scenarios import get
 from .sec4 import PID
@@ -36,12 +40,16 @@ def readings() -> list[str]:
         f"{TABLE2.h0_heating_W_m2K:g}, h2 = {TABLE2.h2_heating_W_m2K3:g}, C_DF = {TABLE2.C_DF_heating_Nms:g}), open "
         f"loop, the set's V_H = {TABLE2.V_H_V:g} V on one wire for {OPEN_LOOP_ON_S:g} s, then removed; the "
         f"spring-length variations use `spring_init = given`, all others the set's `{TABLE2.spring_init}`.",
-        f"- Figs. 11-15: parameter set `{p.name}` (Sec. 3.2 coefficients, PID {PID} updated every "
+        f"- Figs. 10(a)-15: parameter set `{p.name}` (Sec. 3.2 coefficients, PID {PID} updated every "
         f"{p.controller_update_s:g} s, controller {'kept on' if p.controller_in_cooling else 'off'} in the "
         "cooling phase unless stated).",
         f"- Friction: `{' '.join(PAPER_FRICTION.texts())}` in every paper scenario: Sec. 3.1 neglects stick-slip "
-        f"(purely viscous friction after the onset of motion). The `{p.name}` set's own default is "
-        f"`{p.friction_sticking}`.",
+        f"(purely viscous friction after the onset of motion); the `{p.name}` set's own default is "
+        f"`{p.friction_sticking}` (smafinger 0.1's was `restick`).",
+        f"- Damping: C_DF's heating value while a wire is in its controller's heating phase, its cooling value "
+        f"otherwise (`damping_switch = {p.damping_switch}`); the Fig. 15 section gives the cycles under each rule.",
+        f"- Hysteresis: `hysteresis = {p.hysteresis}` (return-point memory, the paper2010 sets' default since issue "
+        "10); the section on issue 10 gives Figs. 12, 13 and 15 before and after.",
         f"- Times: a target counts as reached once within {tol:g} deg for {hold:g} s (`reached_s`, from the start "
         "of its segment). With targets issued on reach, a full-cycle time is the sum of the segments' `reached_s` "
         "(the cycle time); the time from t = 0 at which the last target is reached (given beside it, and dashed in "
@@ -80,13 +88,15 @@ def claims_table(outcomes: list[Outcome]) -> list[str]:
 
 
 def investigation_section(rows: list[dict]) -> list[str]:
-    """The Fig. 15 readings table and its findings."""
+    """smafinger 0.1's Fig. 15 readings table (v1 baseline) and its findings."""
     base = rows[0]
     lines = [
-        "## The full-cycle gap (Fig. 15)", "",
+        "## Fig. 15: smafinger 0.1's readings (v1 runs)", "",
         f"The paper gives {PAPER_S['independent']:g} s (independent) and {PAPER_S['cooperative']:g} s "
-        f"(co-operative) for the cycle. Issuing each target as soon as the previous one is reached, smafinger "
-        f"takes {secs(base['independent_s'])} and {secs(base['cooperative_s'])} ("
+        f"(co-operative) for the cycle. These readings start from smafinger 0.1's on-reach runs "
+        f"(`{REACH_V1['independent']}`, `{REACH_V1['cooperative']}`), whose independent strategy uses the "
+        "antagonist once the agonist's wire is back to martensite. Issuing each target as soon as the previous one "
+        f"is reached, smafinger takes {secs(base['independent_s'])} and {secs(base['cooperative_s'])} ("
         + " and ".join(pct(None if base[f'{k}_s'] is None else base[f'{k}_s'] / PAPER_S[k]) for k in PAPER_S)
         + " of the paper's). Each reading below changes one thing from that baseline (co-operative times marked "
         "= are the baseline's run: the reading only concerns the independent strategy). Cycle time as defined "
@@ -111,25 +121,35 @@ def runs_section(runs: dict[str, Run], figures: list[Path]) -> list[str]:
     failed = [r for r in runs.values() if not r.ok]
     if failed:
         lines += ["## Failed runs", ""] + [f"- `{r.key}`: {r.error}" for r in failed] + [""]
-    lines += ["## Runs", "", "| Scenario | Figure | Interlock violations | Wall time |", "|---|---|---|---|"]
+    lines += ["## Runs", "", energy_note(), "",
+              "| Scenario | Figure | Interlock violations | Heat into the wires (upper / lower) | Electrical energy "
+              "at the terminals (upper / lower) | Wall time |", "|---|---|---|---|---|---|"]
     for r in runs.values():
         if r.scenario is None:
             continue
-        v = "failed" if not r.ok else str(r.summary["interlock_violations"])
-        w = "" if not r.ok else f"{1e3 * r.summary['wall_s']:.0f} ms"
-        lines.append(f"| `{r.key}` | {r.scenario.figure} | {v} | {w} |")
+        if not r.ok:
+            lines.append(f"| `{r.key}` | {r.scenario.figure} | failed | | | |")
+            continue
+        heat, elec = (" / ".join(f"{r.summary[k][w]:.2f} J" for w in r.spec.params.wire_names)
+                      for k in ("heat_J", "electrical_energy_J"))
+        lines.append(f"| `{r.key}` | {r.scenario.figure} | {r.summary['interlock_violations']} | {heat} | {elec} | "
+                     f"{1e3 * r.summary['wall_s']:.0f} ms |")
     return lines + [""]
 
 
 def write_report(path: Path, outcomes: list[Outcome], rows: list[dict] | None, runs: dict[str, Run],
-                 figures: list[Path], wall_s: float, workers: int) -> None:
-    """Write ``report.md`` (atomically)."""
+                 figures: list[Path], wall_s: float, workers: int, tables: dict | None = None) -> None:
+    """Write ``report.md`` (atomically); ``tables``: the studies' (:func:`.issue10.study_tables`)."""
     n_sc = sum(1 for r in runs.values() if r.scenario is not None)
     lines = ["# smafinger: reproduction of Gilardi et al., Robotica 28(5):675-687 (2010)", "",
              f"Generated by `smafinger reproduce` (smafinger {__version__}): {n_sc} scenario runs"
              + (f" and {len(runs) - n_sc} investigation runs" if len(runs) > n_sc else "")
              + f" on {workers} worker process(es), {wall_s:.1f} s in all.", ""]
     lines += readings() + claims_table(outcomes)
+    if tables and tables["hysteresis"]:
+        lines += hysteresis_section(tables["hysteresis"])
+    if tables and tables["cycles"]:
+        lines += cycle_section(tables["cycles"], tables["moves"])
     if rows:
         lines += investigation_section(rows)
     lines += runs_section(runs, figures)

@@ -7,7 +7,8 @@ worker processes, then writes into the output directory:
 - ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms);
 - ``summary.json``: per scenario, its definition, ``result.summary()`` and its figure
   metrics (``derived``), both computed in the worker from the full 1 ms output;
-- ``investigation.json``: the Fig. 15 readings (when both on-reach Fig. 15 scenarios ran);
+- ``investigation.json``: the Fig. 15 readings of smafinger 0.1 and the studies' tables
+  (:mod:`.studies`, :mod:`.issue10`), when both v1 on-reach Fig. 15 scenarios ran;
 - ``report.md``: each claim beside smafinger's value and verdict (:mod:`.report`).
 
 Each file is written atomically; JSON numbers are rounded to :data:`JSON_DIGITS`
@@ -33,7 +34,8 @@ from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
 from .derived import Derivation, Run, derive
-from .fig15 import REACH
+from .fig15 import REACH_V1
+from .issue10 import study_tables
 from .report import write_report
 
 #: keep every EVERY-th output sample (1 ms) in the CSVs and the figures (10 ms)
@@ -190,12 +192,12 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     chosen = select(only)  # before anything is written: a bad name leaves no directory
     names = [s.name for s in chosen]
     if investigate is None:
-        investigate = all(n in names for n in REACH.values())
-    tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks() if investigate else [])
+        investigate = all(n in names for n in REACH_V1.values())
+    tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks(names) if investigate else [])
     n_workers = max(1, min(workers or available_cores(), len(tasks)))
     (out_dir / "runs").mkdir(parents=True, exist_ok=True)
 
-    derivations = {k: inv.DERIVE for k, _ in tasks}
+    derivations = inv.derivations() if investigate else {}
     derivations.update({s.name: s.derive for s in chosen})
     runs = _simulate(tasks, n_workers, progress, derivations)
     for s in chosen:
@@ -204,11 +206,12 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     _write_runs(out_dir, scen_runs)
     figures = _draw(out_dir, scen_runs)
     rows = inv.table(runs) if investigate else None
+    tables = study_tables(runs) if investigate else None
     if rows is not None:
-        write_json(out_dir / "investigation.json", rows)
+        write_json(out_dir / "investigation.json", {"readings": rows, "studies": tables})
     outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
     wall = time.perf_counter() - t0
-    write_report(out_dir / "report.md", outcomes, rows, runs, figures, wall, n_workers)
+    write_report(out_dir / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
     return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
 
 

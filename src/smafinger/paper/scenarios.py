@@ -13,7 +13,7 @@ gets a new version, so that a name always means the same run.
 >>> spec = s.spec(overrides=["M_SF_Nm=0.02"], dt_s=5e-4)
 
 The scenarios and claims are declared figure by figure (:mod:`.sec31`, :mod:`.sec4`,
-:mod:`.fig15`, :mod:`.authors`); this module is their registry. Adding a scenario or a
+:mod:`.fig10`, :mod:`.fig11`, :mod:`.fig15`, :mod:`.authors`); this module is their registry. Adding a scenario or a
 claim is one entry in the figure's module. The readings they share are in
 :mod:`.scenario` and ``docs/reproduce.md``.
 """
@@ -22,13 +22,14 @@ from __future__ import annotations
 
 from types import MappingProxyType
 
-from . import authors, fig15, sec4, sec31
+from . import authors, fig10, fig11, fig15, sec4, sec31
 from .claim import Claim
 from .overrides import Overrides
 from .scenario import MOVE_S, OPEN_LOOP_ON_S, PAPER_FRICTION, Figure, Scenario
 
 #: every output figure, in the paper's order
-FIGURES: tuple[Figure, ...] = sec31.FIGURES + sec4.FIGURES + fig15.FIGURES + authors.FIGURES
+FIGURES: tuple[Figure, ...] = (sec31.FIGURES + fig10.FIGURES + fig11.FIGURES + sec4.FIGURES + fig15.FIGURES
+                                + authors.FIGURES)
 #: claims about every run rather than one figure
 GENERAL_CLAIMS: tuple[Claim, ...] = (authors.INTERLOCK,)
 

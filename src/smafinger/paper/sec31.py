@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..metrics import START_OF_MOTION_DEG
+from ..metrics import REST_SPEED_DEG_S, START_OF_MOTION_DEG
 from ..parameters import get as get_params
 from . import figures
 from .claim import Check, Claim, decreasing, increasing, spread
@@ -21,7 +21,7 @@ PARAMS = "paper2010-table2"
 TABLE2 = get_params(PARAMS)
 WIRES = {"upper": "upper wire heated (extension)", "lower": "lower wire heated (flexion)"}
 #: a variant has reached its full range if slower than this over the last second of heating
-STILL_DEG_S = 0.05
+STILL_DEG_S = REST_SPEED_DEG_S
 #: C_DF changes the speed, not the range: the ranges agree within this fraction
 RANGE_AGREEMENT = 0.10
 #: variations of our own where the paper gives no values: +-50% of Table II's h2,
