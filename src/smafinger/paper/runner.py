@@ -16,19 +16,15 @@ significant digits.
 
 from __future__ import annotations
 
-import dataclasses
 import fnmatch
-import json
-import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-import numpy as np
-
 from ..engine.run import RunSpec
-from ..results import SimulationResult, atomic_write
+from ..files import JSON_DIGITS, json_ready, write_json  # noqa: F401  (json_ready re-exported)
+from ..results import SimulationResult
 from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
@@ -38,9 +34,6 @@ from .report import write_report
 
 #: keep every EVERY-th output sample (1 ms) in the CSVs and the figures (10 ms)
 EVERY = 10
-#: significant digits of the numbers in the JSON outputs: float noise goes, and a time below
-#: 1000 s keeps the engine's 1 ns clock
-JSON_DIGITS = 12
 
 
 @dataclass(frozen=True)
@@ -105,26 +98,6 @@ def select(only: Iterable[str] | None) -> list[scn.Scenario]:
             hits = [pat]
         chosen += [h for h in hits if h not in chosen]
     return [scn.get(n) for n in scn.names() if n in chosen]
-
-
-def json_ready(obj: Any, digits: int = JSON_DIGITS) -> Any:
-    """``obj`` with every float rounded to ``digits`` significant digits, non-finite ones
-    as ``None`` and numpy scalars and arrays as Python values."""
-    if isinstance(obj, dict):
-        return {k: json_ready(v, digits) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple, np.ndarray)):
-        return [json_ready(v, digits) for v in obj]
-    if isinstance(obj, (np.integer, np.bool_)):
-        return obj.item()
-    if isinstance(obj, (float, np.floating)):
-        x = float(obj)
-        return float(f"{x:.{digits}g}") if math.isfinite(x) else None
-    return obj
-
-
-def write_json(path: Path, obj: Any) -> None:
-    text = json.dumps(json_ready(obj), indent=2)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(text + "\n"))
 
 
 @dataclass
