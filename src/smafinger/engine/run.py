@@ -161,8 +161,12 @@ def _call(args: dict, mech, wires, seg_actual, seg_reached):
     return run_kernel(args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached)
 
 
-def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
-    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`."""
+def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
+    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
+
+    ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
+    :class:`smafinger.progress.Display`.
+    """
     args = kernel_args(spec)
     run = args["run"]
     n_wires = len(spec.params.wire_names)
@@ -177,7 +181,7 @@ def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
     t0 = time.perf_counter()
     if progress:
         counters, state, t_fail = _run_with_progress(lambda: _call(args, mech, wires, seg_actual, seg_reached),
-                                                     mech, spec.t_end_s)
+                                                     mech, spec.t_end_s, progress)
     else:
         counters, state, t_fail = _call(args, mech, wires, seg_actual, seg_reached)
     wall = time.perf_counter() - t0
@@ -202,21 +206,28 @@ def describe_state(p: ParameterSet, state) -> str:
     return ", ".join(parts)
 
 
-def _run_with_progress(call, mech, t_end_s):
-    """Run the (nogil) kernel in a thread and show its progress from the output rows."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+def _run_with_progress(call, mech, t_end_s, progress):
+    """Run the (nogil) kernel in a thread and show its progress from the output rows.
 
+    ``progress``: ``True`` (a bar on a terminal, plain lines otherwise) or a
+    :class:`smafinger.progress.Display`.
+    """
+    from ..progress import Display
+
+    display = progress if isinstance(progress, Display) else Display.auto(True)
     box = []
     th = threading.Thread(target=lambda: box.append(call()))
-    with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed:.1f}/{task.total:.1f} s"),
-                  TimeRemainingColumn(), transient=True) as bar:
-        task = bar.add_task("sim", total=t_end_s)
+    task = display.task("simulating", t_end_s, "s", integer=False)
+    try:
         th.start()
         while th.is_alive():
             th.join(0.1)
-            done = mech.t
-            filled = done[~np.isnan(done)]
-            bar.update(task, completed=float(filled[-1]) if filled.size else 0.0)
+            filled = mech.t[~np.isnan(mech.t)]
+            task.update(completed=float(filled[-1]) if filled.size else 0.0)
+    finally:
+        th.join()
+        if display is not progress:
+            display.stop()
     return box[0]
 
 

@@ -111,16 +111,21 @@ class ReproduceOutput:
     failed: list[str] = field(default_factory=list)
 
 
-def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress: bool,
+def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress,
               derivations: dict[str, Derivation | None]) -> dict[str, Run]:
-    if not progress:
-        return run_tasks(tasks, workers, derivations=derivations)
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    """:func:`run_tasks` with a progress display (``progress``: a flag or a
+    :class:`~smafinger.progress.Display`)."""
+    from ..progress import Display
 
-    with Progress(TextColumn("[bold]reproduce[/bold] {task.description}"), BarColumn(),
-                  MofNCompleteColumn(), TimeElapsedColumn(), transient=True) as bar:
-        task = bar.add_task("simulating", total=len(tasks))
-        return run_tasks(tasks, workers, lambda key: bar.update(task, advance=1, description=key), derivations)
+    display = progress if isinstance(progress, Display) else Display.auto(bool(progress))
+    if not display.enabled:
+        return run_tasks(tasks, workers, derivations=derivations)
+    task = display.task("reproduce", len(tasks), "runs")
+    try:
+        return run_tasks(tasks, workers, lambda key: task.update(advance=1, note=key), derivations)
+    finally:
+        if display is not progress:
+            display.stop()
 
 
 def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
@@ -149,12 +154,13 @@ def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:
 
 
 def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
-              progress: bool = False, investigate: bool | None = None) -> ReproduceOutput:
+              progress=False, investigate: bool | None = None) -> ReproduceOutput:
     """Run the scenarios and write figures, CSVs, summary.json, investigation.json and
     report.md into ``out_dir``.
 
     ``only``: scenario names or glob patterns (default: all). ``investigate``: run the Fig. 15
-    readings (default: when both on-reach Fig. 15 scenarios are selected).
+    readings (default: when both on-reach Fig. 15 scenarios are selected). ``progress``: a
+    flag or a :class:`~smafinger.progress.Display`.
     """
     from ..engine.batch import available_cores
 
