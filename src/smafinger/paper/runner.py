@@ -4,14 +4,17 @@
 worker processes, then writes into the output directory:
 
 - one PNG per figure (``fig07-cdf.png``, ``fig08-h0.png``, ...);
-- ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms);
-- ``summary.json``: per scenario, its definition, ``result.summary()`` and its figure
-  metrics (``derived``), both computed in the worker from the full 1 ms output;
+- ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms),
+  and ``runs/NAME.provenance.json`` (the run's definition; ``samples_every`` says the
+  thinning);
+- ``summary.json``: per scenario, its definition, ``result.summary()``, its figure
+  metrics (``derived``), both computed in the worker from the full 1 ms output, and its
+  ``provenance`` (:mod:`smafinger.provenance`, exact);
 - ``investigation.json``: the Fig. 15 readings (when both on-reach Fig. 15 scenarios ran);
 - ``report.md``: each claim beside smafinger's value and verdict (:mod:`.report`).
 
 Each file is written atomically; JSON numbers are rounded to :data:`JSON_DIGITS`
-significant digits.
+significant digits, except in the provenance (exact: a run can be made again).
 """
 
 from __future__ import annotations
@@ -129,18 +132,26 @@ def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress,
 
 
 def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
-    """``runs/NAME.csv`` of every scenario run and ``summary.json``."""
+    """``runs/NAME.csv`` (with its provenance sidecar) of every scenario run and
+    ``summary.json`` (numbers rounded, each run's provenance exact)."""
+    from ..export import add_signals
+    from ..files import Outputs
+    from ..provenance import provenance
+
     summary: dict[str, Any] = {}
     for name, r in runs.items():
-        entry: dict[str, Any] = {"scenario": r.scenario.definition()}
+        entry: dict[str, Any] = json_ready({"scenario": r.scenario.definition()})
         if r.ok:
-            r.result.save(out_dir / "runs" / f"{name}.csv")
-            entry.update(r.summary)
-            entry["derived"] = r.derived
+            out = Outputs()
+            add_signals(out, r.result, out_dir / "runs" / f"{name}.csv", scenario=name, samples_every=EVERY)
+            out.commit()
+            entry.update(json_ready(r.summary))
+            entry["derived"] = json_ready(r.derived)
+            entry["provenance"] = provenance(r.spec, scenario=name)
         else:
             entry["error"] = r.error
         summary[name] = entry
-    write_json(out_dir / "summary.json", summary)
+    write_json(out_dir / "summary.json", summary, digits=None)
 
 
 def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:

@@ -58,6 +58,12 @@ def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> 
         raise ParameterError(f"{path}: {exc}") from None
 
 
+def from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+    """A set from plain values, laid out as in a parameter file (``mechanism``, ``base``, the
+    fields, options in an ``options`` table or at the top level, as ``to_dict`` gives them)."""
+    return _from_dict(data, registry_get)
+
+
 def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
     data = dict(data)
     base_name = data.pop("base", None)

@@ -145,11 +145,19 @@ def table_variables(columns: Mapping[str, np.ndarray], provenance: Mapping | Non
 
 
 def save_mat(file: str | Path, mdict: dict) -> None:
-    """Write MATLAB variables (from :func:`mat_variables`) to ``file`` as a v5 ``.mat``."""
+    """Write MATLAB variables (from :func:`mat_variables`) to ``file`` as a v5 ``.mat``.
+
+    The file's 116-byte text header names smafinger instead of the time of writing, so that
+    the same variables always make the same bytes.
+    """
     from scipy.io import savemat
+
+    from .. import __version__
 
     with open(file, "wb") as fh:
         savemat(fh, mdict, format="5", long_field_names=True, do_compression=True, oned_as="column")
+        fh.seek(0)
+        fh.write(f"MATLAB 5.0 MAT-file, written by smafinger {__version__}".ljust(116).encode("ascii"))
 
 
 def _times(t_s) -> np.ndarray:
