@@ -21,7 +21,7 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from smafinger.analysis.joint_fit import synthesize
-from smafinger.cli_identify import app
+from smafinger.cli.identify import app
 from smafinger.parameters import get
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -71,3 +71,45 @@ def check(result) -> list[str]:
                        f"eps_R = {p.eps_R:g} (+{STRAIN_MARGIN:g}): the wire would deform plastically, "
                        "which the model does not describe")
     return out
+
+
+# ---------------------------------------------------------------------------------------
+# what to change after a numerical blow-up
+# ---------------------------------------------------------------------------------------
+#: the reference set of each mechanism: a parameter this many times away from it looks extreme
+REFERENCE_SETS = {"joint": "paper2010", "linear-bias-spring": "linear-bias-spring"}
+EXTREME_FACTOR = 10.0
+
+
+def extreme_parameters(params) -> list[str]:
+    """The parameters of a set furthest from its mechanism's reference set (at least
+    :data:`EXTREME_FACTOR` times larger or smaller), furthest first, as ``NAME = VALUE`` texts."""
+    import math
+
+    from .parameters import get
+
+    ref_name = REFERENCE_SETS.get(params.mechanism)
+    if ref_name is None:
+        return []
+    ref = get(ref_name)
+    found = []
+    for name in params.field_names():
+        v, r = getattr(params, name), getattr(ref, name)
+        if isinstance(v, str) or isinstance(v, bool) or not (v > 0 and r > 0):
+            continue
+        factor = max(v / r, r / v)
+        if factor >= EXTREME_FACTOR:
+            found.append((factor, f"{name} = {v:g} ({'%.0f' % factor}x {'above' if v > r else 'below'} "
+                                  f"{ref_name}'s {r:g})"))
+    return [text for factor, text in sorted(found, key=lambda x: -x[0]) if math.isfinite(factor)]
+
+
+def blowup_hint(spec) -> str:
+    """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
+    hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
+    if spec.method != "rk4":
+        hint += " or --method rk4"
+    extreme = extreme_parameters(spec.params)
+    if extreme:
+        hint += f"; check {extreme[0]}"
+    return hint

@@ -15,6 +15,7 @@ from numba import typeof
 from ..control.strategies import STRATEGIES, enable_mask
 from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
+from ..progress import Display
 from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
 from . import integrators
@@ -233,7 +234,8 @@ def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
     """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
 
     ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
-    :class:`smafinger.progress.Display`.
+    :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
+    a thread, so that Ctrl-C is answered at once).
     """
     args = kernel_args(spec)
     run = args["run"]
@@ -247,7 +249,7 @@ def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
         warm = dict(args, run=run._replace(t_end_ticks=run.dt_ticks, out_ticks=run.dt_ticks))
         _call(warm, *new_outputs(2, n_wires), seg_actual.copy(), seg_reached.copy())
     t0 = time.perf_counter()
-    if progress:
+    if progress is True or isinstance(progress, Display):
         counters, state, t_fail = _run_with_progress(lambda: _call(args, mech, wires, seg_actual, seg_reached),
                                                      mech, spec.t_end_s, progress)
     else:
@@ -278,13 +280,13 @@ def _run_with_progress(call, mech, t_end_s, progress):
     """Run the (nogil) kernel in a thread and show its progress from the output rows.
 
     ``progress``: ``True`` (a bar on a terminal, plain lines otherwise) or a
-    :class:`smafinger.progress.Display`.
+    :class:`smafinger.progress.Display`. The calling thread only waits, so Ctrl-C stops the
+    wait at once (the compiled loop cannot be interrupted: its daemon thread is left to end
+    with the process).
     """
-    from ..progress import Display
-
     display = progress if isinstance(progress, Display) else Display.auto(True)
     box = []
-    th = threading.Thread(target=lambda: box.append(call()))
+    th = threading.Thread(target=lambda: box.append(call()), daemon=True)
     task = display.task("simulating", t_end_s, "s", integer=False)
     try:
         th.start()
@@ -293,7 +295,6 @@ def _run_with_progress(call, mech, t_end_s, progress):
             filled = mech.t[~np.isnan(mech.t)]
             task.update(completed=float(filled[-1]) if filled.size else 0.0)
     finally:
-        th.join()
         if display is not progress:
             display.stop()
     return box[0]
