@@ -109,7 +109,7 @@ def sweep_size(spec: SweepSpec, traces: bool) -> SweepSize:
     profile = spec.base.get("profile")
     n_seg = profile.count(",") + 1 if isinstance(profile, str) else 1
     n_cols = 2 + len(spec.vary) + len(METRIC_COLUMNS) + 4 * n_seg
-    samples = math.floor(_max_t_end(spec) / spec.traces_interval_s) + 1
+    samples = int(min(_max_t_end(spec) / spec.traces_interval_s, 1e18)) + 1  # 1e308 s: refused later, no overflow
     per_sample = 8 + 8 + 4 * (len(TRACE_COLUMNS) - 1) + 4  # t_s, point, float32 signals, run_id
     lhs = 8 * n * len(spec.vary) if spec.mode == "lhs" else 0
     return SweepSize(n, n * n_cols * 8, n * samples * per_sample if traces else 0, n * 45 + lhs)

@@ -23,6 +23,7 @@ from __future__ import annotations
 import functools
 import os
 import sys
+import traceback
 from contextlib import contextmanager
 
 import typer
@@ -86,6 +87,13 @@ def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
                          "(please report it; SMAFINGER_DEBUG=1 shows where)")
 
 
+def _report(line: str) -> None:
+    """Print the one line (after the traceback of an internal error, with SMAFINGER_DEBUG=1)."""
+    if line.startswith("smafinger: internal error") and os.environ.get("SMAFINGER_DEBUG"):
+        traceback.print_exc()
+    print(line, file=sys.stderr)
+
+
 def command(interrupted: str = ""):
     """Decorate a command: any exception becomes one line on stderr and its exit status
     (:func:`classify`); ``interrupted`` is said after Ctrl-C."""
@@ -98,10 +106,7 @@ def command(interrupted: str = ""):
                 raise
             except BaseException as exc:
                 code, line = classify(exc, interrupted)
-                if code == EXIT_FAILED and line.startswith("smafinger: internal error") and os.environ.get(
-                        "SMAFINGER_DEBUG"):
-                    raise
-                print(line, file=sys.stderr)
+                _report(line)
                 raise typer.Exit(code) from None
         return run
     return wrap
@@ -134,6 +139,6 @@ def run_app(app: typer.Typer, argv: list[str] | None) -> int:
         if isinstance(exc, (SystemExit, GeneratorExit)):
             raise
         code, line = classify(exc)
-        print(line, file=sys.stderr)
+        _report(line)
         return code
     return rv if isinstance(rv, int) else EXIT_OK
