@@ -136,3 +136,11 @@ def test_thresholds_are_applied_at_their_values():
 
 def resolve_with(*overrides):
     return get("paper2010").with_overrides(list(overrides))
+
+
+def test_no_scenario_of_the_paper_gives_a_warning():
+    from smafinger.paper import scenarios
+
+    for s in scenarios.all_scenarios():
+        r = run_spec(s.spec())
+        assert r.metrics["warnings"] == [], (s.name, r.metrics["warnings"])
