@@ -144,3 +144,12 @@ def test_no_scenario_of_the_paper_gives_a_warning():
     for s in scenarios.all_scenarios():
         r = run_spec(s.spec())
         assert r.metrics["warnings"] == [], (s.name, r.metrics["warnings"])
+
+
+def test_sweep_run_ids_take_any_number_of_wires_and_keep_the_joint_text():
+    from smafinger.analysis.sweep_spec import canonical_run, run_id
+
+    joint = make_spec("paper2010-table2", "open-loop", None, "0:8:0,8:0:0", t_end_s=1.0)
+    assert canonical_run(joint)["voltage"] == "0.0:8.0:0.0,8.0:0.0:0.0"  # the text run ids were made from
+    rig = make_spec("linear-bias-spring", "open-loop", None, "0:8,2:0", t_end_s=3.0)
+    assert canonical_run(rig)["voltage"] == "0.0:8.0,2.0:0.0" and len(run_id(rig)) == 16

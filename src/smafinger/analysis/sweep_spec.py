@@ -74,7 +74,8 @@ def canonical_run(spec: RunSpec) -> dict:
         "params": spec.params.to_dict(),
         "strategy": spec.strategy,
         "profile": spec.profile.to_text(),
-        "voltage": None if v is None else ",".join(f"{t!r}:{a!r}:{b!r}" for t, a, b in v.steps),
+        # one value per wire (two for the joint: the same text as schema 1 always gave)
+        "voltage": None if v is None else ",".join(":".join(repr(x) for x in step) for step in v.steps),
         "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method,
         "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg,
         "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
