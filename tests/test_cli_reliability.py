@@ -215,3 +215,17 @@ def test_sweep_writes_a_matlab_table_with_provenance(tmp_path, capsys):
     assert prov["base_parameters"]["name"] == "paper2010-table2" and prov["base_run_settings"]["dt_s"] == 1e-3
     meta = json.loads(pq.read_schema(tmp_path / "s.parquet").metadata[b"smafinger.sweep"])
     assert meta["provenance"] == prov
+
+
+def test_a_parameter_file_without_name_source_or_base_is_complete_enough(here, capsys):
+    from smafinger.parameters import get
+
+    for mech in ("paper2010", "linear-bias-spring"):
+        text = "\n".join(ln for ln in get(mech).to_toml().splitlines() if not ln.startswith(("name", "source")))
+        (here / "p.toml").write_text(text + "\n")
+        args = ["--profile", "0:-25"] if mech == "paper2010" else ["--strategy", "open-loop", "--voltage", "0:8"]
+        rc, out, err = run(capsys, "simulate", "--params", "p.toml", *args, "--t-end", "0.5", "--summary", "s.json",
+                           "--no-progress")
+        assert rc == 0, err
+        assert json.loads((here / "s.json").read_text())["provenance"]["run"]["parameters"]["name"] == "custom"
+        assert run(capsys, "params", "p.toml")[1].splitlines()[2] == 'name = "custom"  # name of the set'

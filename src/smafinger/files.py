@@ -71,6 +71,19 @@ def check_output(path: str | Path, what: str | None = None) -> Path:
     return path
 
 
+def check_outputs(targets) -> list[Path]:
+    """:func:`check_output` of every ``(path, what)``, and no file named twice."""
+    seen: set[Path] = set()
+    out = []
+    for path, what in targets:
+        path = check_output(path, what)
+        if path.resolve() in seen:
+            raise OutputError(f"{what or 'output file'} {path}: the same file is given for two outputs")
+        seen.add(path.resolve())
+        out.append(path)
+    return out
+
+
 def fsync_dir(folder: Path) -> None:
     """Flush a folder's entries to disk (no-op where folders cannot be opened)."""
     try:
@@ -106,10 +119,7 @@ class Outputs:
         self._items: list[tuple[Path, Callable[[str], object]]] = []
 
     def add(self, path: str | Path, write: Callable[[str], object], what: str | None = None) -> "Outputs":
-        path = check_output(path, what)
-        for other, _ in self._items:
-            if other.resolve() == path.resolve():
-                raise OutputError(f"{what or 'output file'} {path}: the same file is given for two outputs")
+        path = check_outputs([*((p, None) for p in self.paths), (path, what)])[-1]
         self._items.append((path, write))
         return self
 

@@ -31,18 +31,18 @@ REPORT_HELP = "fit report FIT.json"
 PLOT_HELP = "data vs model figure FIT.png (.pdf, .svg)"
 
 
-def _targets(out: Path | None, report: Path | None, plot: Path | None) -> list[tuple[Path, str, tuple]]:
+def _targets(out: Path | None, report: Path | None, plot: Path | None) -> list[tuple[Path, str]]:
     """The requested outputs, checked before any work (bad name or folder: exit 2)."""
     from ..export import PLOT_SUFFIXES, check_suffix
-    from ..files import Outputs
+    from ..files import check_outputs
 
-    plan, targets = Outputs(), []
+    targets = []
     for path, what, allowed in ((out, "--out", (".toml",)), (report, "--report", (".json",)),
                                 (plot, "--plot", PLOT_SUFFIXES)):
         if path is not None:
             check_suffix(path, allowed, what)
-            plan.add(path, None, what)
             targets.append((path, what))
+    check_outputs(targets)
     return targets
 
 

@@ -82,16 +82,16 @@ def simulate(
 def _check_outputs(out: Path | None, summary: Path | None, plot: Path | None) -> None:
     """Refuse bad output names before anything runs."""
     from ..export import PLOT_SUFFIXES, SIGNAL_FORMATS, check_suffix, sidecar_path
-    from ..files import Outputs
+    from ..files import check_outputs
 
-    plan = Outputs()
+    targets = []
     for path, what, allowed in ((out, "--out", SIGNAL_FORMATS), (summary, "--summary", (".json",)),
                                 (plot, "--plot", PLOT_SUFFIXES)):
         if path is not None:
-            suffix = check_suffix(path, allowed, what)
-            plan.add(path, None, what)
-            if suffix == ".csv":
-                plan.add(sidecar_path(path), None, f"{what} (its provenance sidecar)")
+            targets.append((path, what))
+            if check_suffix(path, allowed, what) == ".csv":
+                targets.append((sidecar_path(path), f"{what} (its provenance sidecar)"))
+    check_outputs(targets)
 
 
 def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt, method,
