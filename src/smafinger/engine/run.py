@@ -140,8 +140,8 @@ def memory_limit_bytes() -> int:
 
 
 def output_size(spec: RunSpec, run: RunSettings) -> tuple[int, int, int]:
-    """(samples, signals, bytes) a run records; bytes counts the engine's arrays and the
-    result's copy of them (the peak while the run is stored)."""
+    """(samples, signals, bytes) a run records; bytes counts the recorded arrays and one copy
+    of them (as exporting the result makes: a table, a file)."""
     samples = run.t_end_ticks // run.out_ticks + 1
     signals = len(MECHANISM_FIELDS) + len(spec.params.wire_names) * len(WIRE_FIELDS)
     return samples, signals, 2 * 8 * samples * signals
@@ -153,7 +153,7 @@ def _check_output_size(spec: RunSpec, run: RunSettings) -> None:
     if need > limit:
         raise ValueError(
             f"output_interval_s = {spec.output_interval_s!r} s over t_end_s = {spec.t_end_s!r} s records "
-            f"{samples:,} samples x {signals} signals, about {need / 2**30:,.1f} GiB while the run is stored: "
+            f"{samples:,} samples x {signals} signals, about {need / 2**30:,.1f} GiB with one copy for export: "
             f"more than the {limit / 2**30:.1f} GiB allowed (half of this machine's memory); record less "
             "often (a longer output interval) or simulate less time")
 
