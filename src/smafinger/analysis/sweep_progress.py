@@ -7,7 +7,7 @@ A live bar on a terminal; in a batch job's log (not a terminal) a line such as `
 
 from __future__ import annotations
 
-from ..progress import Display, duration  # noqa: F401  (duration: re-exported)
+from ..progress import Display
 
 
 class Progress:

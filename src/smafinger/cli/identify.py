@@ -135,3 +135,9 @@ def joint(
         ident = identify_joint(h_exps, c_exps, base_set, base_spec, fit_msf, display)
     ident.report = {"command": "identify joint", "base": params, "overrides": list(set_ or []), **ident.report}
     _finish(ident, targets)
+
+
+# identify actuator (issue 12): its command, written in smafinger/cli_identify_actuator.py, moves
+# here as cli/identify_actuator.py and is mounted like the two above:
+#     from .identify_actuator import actuator
+#     app.command()(command(interrupted=NOTHING_WRITTEN)(actuator))
