@@ -123,29 +123,30 @@ def test_json_times_carry_no_float_noise(here, capsys):
 
 # ---- re-running a recorded run --------------------------------------------------------------------
 def test_from_a_summary_re_runs_byte_for_byte(here, capsys):
-    first = ["--out", "a.csv", "--summary", "a.json"]
-    assert run(capsys, "simulate", "--params", "authors2020", "--set", "M_SF_Nm=0.0123", "--strategy", "independent",
-               "--profile", "0:-25:upper,reach:-40", "--t-end", "6", "--dt", "5e-4", "--output-interval", "0.002",
-               *first, "--no-progress")[0] == 0
-    for fmt in ("parquet", "mat"):  # the other formats of the same run
-        assert run(capsys, "simulate", "--from", "a.json", "--out", f"a.{fmt}", "--no-progress")[0] == 0
-    for source in ("a.json", "a.csv", "a.parquet", "a.mat"):
+    run_options = ["--params", "authors2020", "--set", "M_SF_Nm=0.0123", "--strategy", "independent", "--profile",
+                   "0:-25:upper,reach:-40", "--t-end", "6", "--dt", "5e-4", "--output-interval", "0.002", "--no-progress"]
+    for fmt in ("csv", "parquet", "mat"):  # the first run, in every format
+        assert run(capsys, "simulate", *run_options, "--out", f"a.{fmt}", "--summary", f"a_{fmt}.json")[0] == 0
+    for source in ("a_csv.json", "a.csv", "a.parquet", "a.mat"):
         stem = "b_" + source.replace(".", "_")
-        rc, _, err = run(capsys, "simulate", "--from", source, "--out", f"{stem}.csv", "--summary", f"{stem}.json",
-                         "--no-progress")
-        assert rc == 0, err
-        assert (here / f"{stem}.csv").read_bytes() == (here / "a.csv").read_bytes()
-        assert json.loads((here / f"{stem}.provenance.json").read_text())["run"] == \
-            json.loads((here / "a.provenance.json").read_text())["run"]
-        a, b = (json.loads((here / n).read_text()) for n in ("a.json", f"{stem}.json"))
-        assert a.pop("wall_s") > 0 and b.pop("wall_s") > 0  # the run's timing: the one value that differs
-        assert b["provenance"].pop("rerun_of") == source and a == b
-    # the same run again, in the binary formats: the same bytes
-    for fmt in ("parquet", "mat"):
-        assert run(capsys, "simulate", "--from", "a.json", "--out", f"c.{fmt}", "--no-progress")[0] == 0
-        assert (here / f"c.{fmt}").read_bytes() == (here / f"a.{fmt}").read_bytes(), fmt
-    meta = json.loads(pq.read_schema(here / "c.parquet").metadata[export.PARQUET_KEY])
-    assert meta["run"] == json.loads((here / "a.provenance.json").read_text())["run"]
+        for fmt in ("csv", "parquet", "mat"):
+            rc, _, err = run(capsys, "simulate", "--from", source, "--out", f"{stem}.{fmt}", "--summary",
+                             f"{stem}.json", "--no-progress")
+            assert rc == 0, err
+            assert (here / f"{stem}.{fmt}").read_bytes() == (here / f"a.{fmt}").read_bytes(), (source, fmt)
+        assert (here / f"{stem}.provenance.json").read_bytes() == (here / "a.provenance.json").read_bytes()
+        a, b = (json.loads((here / n).read_text()) for n in ("a_csv.json", f"{stem}.json"))
+        assert a.pop("wall_s") > 0 and b.pop("wall_s") > 0  # the loop's time on this machine: the one difference
+        assert a == b
+
+
+def test_a_scenario_run_again_records_its_scenario(here, capsys):
+    assert run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "3", "--out", "a.csv",
+               "--no-progress")[0] == 0
+    assert run(capsys, "simulate", "--from", "a.csv", "--out", "b.csv", "--no-progress")[0] == 0
+    assert (here / "b.provenance.json").read_bytes() == (here / "a.provenance.json").read_bytes()
+    assert json.loads((here / "b.provenance.json").read_text())["scenario"] == "fig12-extension-v1"
+    assert (here / "b.csv").read_bytes() == (here / "a.csv").read_bytes()
 
 
 def test_mat_output_holds_every_signal_and_the_provenance(here, capsys):

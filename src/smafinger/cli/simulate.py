@@ -104,7 +104,9 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
         from ..provenance import spec_from_provenance
 
         refuse(ctx, RUN_OPTIONS, f"with --from {from_}: it re-runs the run recorded there")
-        return spec_from_provenance(read_provenance(from_), f"--from {from_}"), {"rerun_of": str(from_)}
+        record = read_provenance(from_)
+        same = {k: v for k, v in record.items() if k not in ("smafinger_version", "run", "run_sha256")}
+        return spec_from_provenance(record, f"--from {from_}"), same  # what the first run recorded, as it did
     programs = [(k, v) for k, v in (("voltage", voltage), ("duty", duty), ("current", current)) if v is not None]
     if len(programs) > 1:
         raise UsageError(f"give one drive program, not {' and '.join('--' + k for k, _ in programs)}")
