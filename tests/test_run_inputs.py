@@ -93,3 +93,15 @@ def test_wrong_types_are_one_line_type_errors_naming_the_argument(kw, message):
 def test_numpy_numbers_are_accepted():
     r = simulate(profile="0:-25", t_end_s=np.float64(0.5), dt_s=np.float32(1e-3).item(), tol_deg=np.int64(1))
     assert math.isclose(r.t[-1], 0.5)
+
+
+def test_whole_numbers_as_parameter_values_run(tmp_path):
+    """``V_H_V = 6`` in a parameter file is an int: the set stores it as a float (an int field
+    made the compiled records of another type, and numba failed with NotImplementedError)."""
+    from smafinger.parameters import get, load_toml
+
+    p = get("paper2010").replace(V_H_V=6, M_SF_Nm=0)
+    assert type(p.V_H_V) is float and type(p.M_SF_Nm) is float and p == get("paper2010").replace(V_H_V=6.0, M_SF_Nm=0.0)
+    (tmp_path / "p.toml").write_text('base = "paper2010"\nV_H_V = 6\n')
+    r = simulate(load_toml(tmp_path / "p.toml"), "open-loop", voltage="0:6:0", t_end_s=0.5)
+    assert r.metrics["energy_J"]["upper"] > 0
