@@ -84,3 +84,17 @@ def test_fitted_parameter_files_start_from_the_named_set(tmp_path):
     (tmp_path / "f.toml").write_text(text)
     assert load_toml(tmp_path / "f.toml") == get("paper2010").replace(name="kinetics-fit", source='on "a.txt"',
                                                                        A_S0_C=61.5)
+
+
+def test_data_whose_fit_is_no_valid_set_are_refused_with_the_field(tmp_path, capsys):
+    """A heating half that only starts to transform at the top of the data extrapolates A_F0
+    beyond its range: bad data, exit 2 naming the field (it was exit 1 'failed', found by the
+    long fuzz)."""
+    T = np.concatenate([np.linspace(30, 299, 30), np.linspace(299, 30, 31)[1:]])
+    e = np.where(np.arange(60) < 30, 0.04 - 0.02 * np.clip((T - 270) / 29, 0, 1),
+                 0.02 + 0.02 * np.clip((120 - T) / 40, 0, 1))
+    path = write(tmp_path / "k.txt", T, e)
+    rc = main(["identify", "kinetics", str(path), "--no-loo", "--no-progress", "--out", str(tmp_path / "f.toml")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and "the fit gives no valid parameter set (A_F0_C = " in err[0]
+    assert "outside the allowed range [-100, 300]" in err[0] and not (tmp_path / "f.toml").exists()

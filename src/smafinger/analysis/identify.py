@@ -25,8 +25,9 @@ UNIT_SUFFIXES = (("_Pa_per_C", "Pa/degC"), ("_W_m2K3", "W/(m^2 K^3)"), ("_W_m2K"
                  ("_Nm", "N m"), ("_Pa", "Pa"), ("_C", "degC"))
 
 
-class IdentificationError(RuntimeError):
-    """The fit ran but its values do not form a valid parameter set."""
+class IdentificationError(ValueError):
+    """The data give fitted values that do not form a valid parameter set (bad input: the
+    data, or the base set, must change)."""
 
 
 def unit_of(name: str) -> str:
@@ -49,13 +50,13 @@ def _fmt(v: float) -> str:
     return f"{v:.6g}"
 
 
-def _toml(values: dict, base_spec, name: str, source: str) -> str:
+def _toml(values: dict, base_spec, command: str, files: str) -> str:
     from ..parameters import ParameterError
 
     try:
-        return parameter_file_text(values, base_spec, name, source)
+        return parameter_file_text(values, base_spec, f"{command}-fit", f"smafinger identify {command} on {files}")
     except ParameterError as exc:
-        raise IdentificationError(f"the fitted values do not form a valid parameter set: {exc}") from None
+        raise IdentificationError(f"{files}: the fit gives no valid parameter set ({exc}); check the data") from None
 
 
 # ---------------------------------------------------------------------------------------
@@ -85,7 +86,7 @@ def identify_kinetics(files: Sequence[Path], validate: Sequence[Path], base, bas
     values = {k: v for k, v in fit.params.as_dict().items() if k in fit.fitted}
     problems = kf.plausibility(fit.params)
     names = ", ".join(c.name for c in fitted)
-    toml = _toml(values, base_spec, "kinetics-fit", f"smafinger identify kinetics on {names}")
+    toml = _toml(values, base_spec, "kinetics", names)
     files_rep = [{"path": c.path, "role": "fitted", "stress_MPa": c.stress_MPa_mean, "n_points": c.n,
                   "rms_strain": fit.rms[c.path]} for c in fitted]
     files_rep += [{"path": c.path, "role": "validated", "stress_MPa": c.stress_MPa_mean, "n_points": c.n,
@@ -161,7 +162,7 @@ def identify_joint(h_exps, c_exps, base, base_spec, fit_msf: bool = False, displ
         task.update(completed=budget)
     wall = time.perf_counter() - t0
     names = ", ".join(Path(c.path).name for c, _ in list(h_exps) + list(c_exps))
-    toml = _toml(fit.values, base_spec, "joint-fit", f"smafinger identify joint on {names}")
+    toml = _toml(fit.values, base_spec, "joint", names)
     lines = [f"fitted {len(h_exps)} heating and {len(c_exps)} cooling curve(s) in {wall:.1f} s "
              f"({fit.heating.nfev + fit.cooling.nfev} simulations)"]
     for pf in (fit.heating, fit.cooling):

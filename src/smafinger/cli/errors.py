@@ -4,10 +4,10 @@
 exit status   meaning
 ============  ===========================================================================
 0             done
-1             the work failed: a numerical blow-up (with what to change), a fit that
-              failed, a file that could not be written, an internal error
+1             the work failed: a numerical blow-up (with what to change), runs of
+              ``reproduce`` that failed, a file that could not be written, an internal error
 2             bad input: one line ``smafinger: error: ...`` naming the option or field
-              and the value; nothing is written
+              and the value (data whose fit is no valid parameter set too); nothing is written
 3             ``sweep``: runs failed (every run, or any with ``--strict``)
 130           interrupted (Ctrl-C; SIGTERM for sweeps): one line saying what was kept
 ============  ===========================================================================
@@ -45,6 +45,7 @@ class WorkFailed(RuntimeError):
 def _input_errors() -> tuple[type[BaseException], ...]:
     """Exception types that are bad input wherever they are raised."""
     from ..analysis.data import DataError
+    from ..analysis.identify import IdentificationError
     from ..analysis.sweep_spec import SweepSpecError
     from ..engine.pools import DistributedMissing, SchedulerError
     from ..files import OutputError
@@ -53,7 +54,7 @@ def _input_errors() -> tuple[type[BaseException], ...]:
     from ..provenance import ProvenanceError
     from ..recordings import RecordingError
 
-    return (UsageError, DataError, SweepSpecError, SchedulerError, DistributedMissing, OutputError,
+    return (UsageError, DataError, IdentificationError, SweepSpecError, SchedulerError, DistributedMissing, OutputError,
             ParameterError, ProfileError, ProvenanceError, RecordingError)
 
 
@@ -64,7 +65,6 @@ def first_line(exc: BaseException | str) -> str:
 
 def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
     """(exit status, the one line to print) for an exception escaping a command."""
-    from ..analysis.identify import IdentificationError
     from ..engine.pools import BatchError
     from ..engine.run import SimulationError
 
@@ -76,7 +76,7 @@ def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
         return EXIT_USAGE, f"smafinger: error: {first_line(exc)}"
     if isinstance(exc, SimulationError):
         return EXIT_FAILED, f"smafinger: simulation failed: {first_line(exc)}"
-    if isinstance(exc, (WorkFailed, BatchError, IdentificationError)):
+    if isinstance(exc, (WorkFailed, BatchError)):
         return EXIT_FAILED, f"smafinger: failed: {first_line(exc)}"
     if isinstance(exc, MemoryError):
         return EXIT_FAILED, "smafinger: out of memory: the run or its outputs do not fit; record less often or less time"
