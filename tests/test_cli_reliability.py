@@ -232,3 +232,12 @@ def test_a_parameter_file_without_name_source_or_base_is_complete_enough(here, c
         assert rc == 0, err
         assert json.loads((here / "s.json").read_text())["provenance"]["run"]["parameters"]["name"] == "custom"
         assert run(capsys, "params", "p.toml")[1].splitlines()[2] == 'name = "custom"  # name of the set'
+
+
+def test_a_sweep_of_another_mechanism_is_refused_before_any_run(tmp_path, capsys):
+    spec = tmp_path / "lin.toml"
+    spec.write_text('[base]\nparams = "linear-bias-spring"\nstrategy = "open-loop"\nvoltage = "0:8,2:0"\n'
+                    't_end_s = 3.0\n[vary]\nbias_spring_K_N_m = [100.0, 200.0]\n')
+    rc, _, err = run(capsys, "sweep", str(spec), "--out", str(tmp_path / "t.parquet"), "--workers", "1")
+    assert rc == 2 and len(err) == 1 and "is a linear-bias-spring set; sweeps tabulate the finger joint only" in err[0]
+    assert files(tmp_path) == ["lin.toml"]
