@@ -39,7 +39,7 @@ class UsageError(ValueError):
 
 
 class WorkFailed(RuntimeError):
-    """The work could not be done with valid input (exit status 1), e.g. a failed fit."""
+    """The work could not be done with valid input (exit status 1), e.g. runs of reproduce that failed."""
 
 
 def _input_errors() -> tuple[type[BaseException], ...]:
