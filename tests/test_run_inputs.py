@@ -105,3 +105,15 @@ def test_whole_numbers_as_parameter_values_run(tmp_path):
     (tmp_path / "p.toml").write_text('base = "paper2010"\nV_H_V = 6\n')
     r = simulate(load_toml(tmp_path / "p.toml"), "open-loop", voltage="0:6:0", t_end_s=0.5)
     assert r.metrics["energy_J"]["upper"] > 0
+
+
+@pytest.mark.parametrize("profile, t_end, every", [("0:-20,0.25:-20,0.375:-20", 1.0, 0.5),  # between samples
+                                                   ("0:-25,0.95:-30", 1.0, 0.3)])  # after the last sample
+def test_segments_without_an_output_sample_have_no_peaks_instead_of_crashing(profile, t_end, every):
+    """Found by the long fuzz: a segment shorter than the output interval made the metrics
+    take the maximum of nothing (or index past the last sample)."""
+    r = simulate("paper2010", "independent", profile, t_end_s=t_end, output_interval_s=every)
+    empty = [s for s in r.metrics["segments"] if s["peak_temperature_C"]["upper"] is None]
+    assert empty and all(s["energy_J"] == {"upper": None, "lower": None} for s in empty)
+    full = [s for s in r.metrics["segments"] if s not in empty]
+    assert all(isinstance(s["peak_temperature_C"]["upper"], float) for s in full)

@@ -235,7 +235,7 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
     temperature per wire (``energy_J`` are cumulative signals). ``q`` is the joint angle [deg]
     or a slider's position [m]; ``unit`` names the keys (``target_deg``, ``overshoot_m``)."""
     m = window(t, span.start_s, span.end_s)
-    k0 = int(np.searchsorted(t, span.start_s - EDGE_S))
+    k0 = min(int(np.searchsorted(t, span.start_s - EDGE_S)), len(t) - 1)  # a segment may fall between samples
     direction = motion_direction(float(q[k0]), span.target)
     return {
         "index": span.index,
@@ -245,8 +245,9 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         "enable": span.enable,
         "reached_s": span.reached_s,
         f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
-        "energy_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()},
-        "peak_temperature_C": {w: float(np.max(T[m])) for w, T in temperature_C.items()},
+        # None: no output sample falls in the segment (it is shorter than the output interval)
+        "energy_J": {w: increase(t, e, span.start_s, span.end_s) if m.any() else None for w, e in energy_J.items()},
+        "peak_temperature_C": {w: float(np.max(T[m])) if m.any() else None for w, T in temperature_C.items()},
     }
 
 
