@@ -14,6 +14,7 @@ Run: ``python benchmarks/bench_identify.py``.
 from __future__ import annotations
 
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -21,11 +22,12 @@ from pathlib import Path
 from typer.testing import CliRunner
 
 from smafinger.analysis.joint_fit import synthesize
-from smafinger.cli_identify import app
+from smafinger.cli.identify import app
 from smafinger.parameters import get
 
 ROOT = Path(__file__).resolve().parent.parent
-DATA = ROOT.parent / "shared" / "data" / "sma-thermal-cycling"
+#: the real data: $SMAFINGER_DATA, default ../shared/data beside the repository (as the tests)
+DATA = Path(os.environ.get("SMAFINGER_DATA", ROOT.parent / "shared" / "data")) / "sma-thermal-cycling"
 
 
 def _csv(path: Path, curve, voltage: bool = True) -> str:

@@ -12,7 +12,7 @@ from scipy.io import loadmat
 from typer.testing import CliRunner
 
 import smafinger
-from smafinger.cli_identify_actuator import actuator
+from smafinger.cli.identify_actuator import actuator
 
 DATA = Path(smafinger.__file__).parent / "data"
 SCRIPT = Path(__file__).resolve().parent.parent / "examples" / "make_bench_data.py"

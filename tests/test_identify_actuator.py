@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from smafinger import simulate
 from smafinger.analysis import bench_synth as bs
 from smafinger.analysis.bench_runs import RigController
-from smafinger.cli_identify_actuator import actuator
+from smafinger.cli.identify_actuator import actuator
 from smafinger.parameters import get, resolve
 
 TEMPLATE = get("linear-bias-spring")

@@ -11,7 +11,7 @@ from smafinger.analysis import bench_synth as bs
 from smafinger.analysis.actuator_fit import FitSettings, fit_actuator
 from smafinger.analysis.bench_runs import load_open_loop
 from smafinger.analysis.free_params import FreeBox, parse_free
-from smafinger.cli_identify_actuator import actuator
+from smafinger.cli.identify_actuator import actuator
 from smafinger.engine.batch import make_pool
 from smafinger.parameters import get
 

@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 from smafinger.analysis.data import (
     MIN_ROWS_JOINT, MIN_ROWS_KINETICS, DataError, load_angle_curve, load_strain_curve,
 )
-from smafinger.cli_identify import app
+from smafinger.cli.identify import app
 
 
 # ---- helpers ----------------------------------------------------------------------------

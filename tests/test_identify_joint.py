@@ -11,7 +11,7 @@ from smafinger.analysis.data import load_angle_curve
 from smafinger.analysis.joint_fit import (
     PHASE_FIELDS, fit_phase, heating_program, simulate_angle, synthesize,
 )
-from smafinger.cli_identify import app
+from smafinger.cli.identify import app
 from smafinger.parameters import get, resolve
 from smafinger.profiles import VoltageProgram
 

@@ -12,12 +12,12 @@ from smafinger.analysis.data import StrainCurve, load_strain_curve
 from smafinger.analysis.kinetics_fit import (
     KineticParams, fit_kinetics, leave_one_out, model_curve, plausibility, rms_strain,
 )
-from smafinger.cli_identify import app
+from smafinger.cli.identify import app
 from smafinger.parameters import get, resolve
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "sma-thermal-cycling"
 LEVELS = (50, 100, 172, 200)
-real_data = pytest.mark.skipif(not DATA.is_dir(), reason=f"real data not found at {DATA}")
+#: tests on the real data set (its folder: $SMAFINGER_DATA or ../shared/data; see conftest.data_dir)
+real_data = pytest.mark.real_data
 
 TRUE = KineticParams(A_S0_C=62.0, A_F0_C=95.0, M_S0_C=73.0, M_F0_C=41.0, c_A_Pa_per_C=8.3e6,
                      c_M_Pa_per_C=7.5e6, eps_R=0.039, D_A_Pa=75e9, D_M_Pa=28e9)
@@ -62,10 +62,9 @@ def test_minor_loop_keeps_xi_continuous_at_the_reversal():
 
 
 @pytest.fixture(scope="module")
-def real_curves():
-    if not DATA.is_dir():
-        pytest.skip(f"real data not found at {DATA}")
-    return [load_strain_curve(DATA / f"filtered_data_{s}MPa.txt") for s in LEVELS]
+def real_curves(data_dir):
+    folder = data_dir("sma-thermal-cycling")
+    return [load_strain_curve(folder / f"filtered_data_{s}MPa.txt") for s in LEVELS]
 
 
 @pytest.fixture(scope="module")

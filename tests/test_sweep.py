@@ -229,7 +229,7 @@ def test_killed_sweep_resumes_every_run_once(tmp_path):
     out = tmp_path / "res.parquet"
     parts = sw.parts_dir(out)
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
-    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli_sweep", str(spec), "--out", str(out),
+    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli", "sweep", str(spec), "--out", str(out),
                              "--workers", "2"], env=env, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
@@ -332,7 +332,7 @@ def _cli(args, cwd):
     from typer.testing import CliRunner
     import typer
 
-    from smafinger.cli_sweep import sweep
+    from smafinger.cli.sweep import sweep
 
     app = typer.Typer()
     app.command("sweep")(sweep)
@@ -498,7 +498,7 @@ def test_sigkill_of_the_client_leaves_no_process(tmp_path):
     spec = _write(tmp_path, _spec(vary, "chunk_size = 1\nsave_interval_s = 0", t_end=20.0))
     out = tmp_path / "res.parquet"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
-    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli_sweep", str(spec), "--out", str(out),
+    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli", "sweep", str(spec), "--out", str(out),
                              "--workers", "2"], env=env, start_new_session=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:

@@ -317,8 +317,10 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
     its heat as ``heat_J``. ``q`` is the joint angle [deg] or a slider's position [m]; ``unit``
     names the keys (``target_deg``, ``overshoot_m``)."""
     m = window(t, span.start_s, span.end_s)
-    electrical = {w: increase(t, e, span.start_s, span.end_s) for w, e in energy_J.items()}
-    k0 = int(np.searchsorted(t, span.start_s - EDGE_S))
+    # None: no output sample falls in the segment (it is shorter than the output interval)
+    some = bool(m.any())
+    electrical = {w: increase(t, e, span.start_s, span.end_s) if some else None for w, e in energy_J.items()}
+    k0 = min(int(np.searchsorted(t, span.start_s - EDGE_S)), len(t) - 1)  # a segment may fall between samples
     direction = motion_direction(float(q[k0]), span.target)
     return {
         "index": span.index,
@@ -330,9 +332,9 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
         "energy_J": electrical,
         "electrical_energy_J": electrical,
-        **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) for w, e in heat_J.items()}}
+        **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) if some else None for w, e in heat_J.items()}}
            if heat_J is not None else {}),
-        "peak_temperature_C": {w: float(np.max(T[m])) for w, T in temperature_C.items()},
+        "peak_temperature_C": {w: float(np.max(T[m])) if some else None for w, T in temperature_C.items()},
     }
 
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -78,22 +77,25 @@ class SimulationResult:
         return pd.DataFrame({name: self.signal(name) for name in self.column_names})
 
     def to_csv(self, path: str | Path) -> None:
-        df = self.to_pandas()
-        atomic_write(path, lambda tmp: df.to_csv(tmp, index=False, float_format="%.9g"))
+        """The signals as CSV, with the provenance in ``NAME.provenance.json`` beside it."""
+        self.save(path)
 
     def to_parquet(self, path: str | Path) -> None:
-        df = self.to_pandas()
-        atomic_write(path, lambda tmp: df.to_parquet(tmp, index=False))
+        """The signals as Parquet, with the provenance in the schema metadata."""
+        self.save(path)
+
+    def to_mat(self, path: str | Path) -> None:
+        """The signals as a MATLAB file (one Structure With Time per signal, and provenance)."""
+        self.save(path)
 
     def save(self, path: str | Path) -> None:
-        """CSV or Parquet by the file's suffix."""
-        suffix = Path(path).suffix.lower()
-        if suffix == ".csv":
-            self.to_csv(path)
-        elif suffix in (".parquet", ".pq"):
-            self.to_parquet(path)
-        else:
-            raise ValueError(f"output file {path}: suffix must be .csv or .parquet")
+        """CSV, Parquet or MATLAB by the file's suffix (:mod:`smafinger.export`), atomically."""
+        from .export import add_signals
+        from .files import Outputs
+
+        out = Outputs()
+        add_signals(out, self, path, "output file")
+        out.commit()
 
     # ---- metrics ---------------------------------------------------------------------
     @property
@@ -116,8 +118,13 @@ class SimulationResult:
         return m
 
     def write_summary(self, path: str | Path) -> None:
-        text = json.dumps(self.summary(), indent=2)
-        atomic_write(path, lambda tmp: Path(tmp).write_text(text + "\n"))
+        """The summary JSON: :meth:`summary` (rounded) and the run's provenance (exact)."""
+        from .export import add_summary
+        from .files import Outputs
+
+        out = Outputs()
+        add_summary(out, self, path, "summary file")
+        out.commit()
 
     def plot(self, path: str | Path | None = None, title: str | None = None):
         from .plotting import plot_result
@@ -137,9 +144,10 @@ def segment_bounds(result: SimulationResult) -> list[tuple[int, float, float]]:
 
 
 def compute_metrics(result: SimulationResult) -> dict:
-    """The run's metrics (:func:`smafinger.metrics.run_metrics`) with its reach settings and
-    interlock count."""
+    """The run's metrics (:func:`smafinger.metrics.run_metrics`) with its reach settings,
+    interlock count and plausibility warnings (:func:`smafinger.plausibility.check`)."""
     from .metrics import Span, run_metrics
+    from .plausibility import check
 
     spec = result.spec
     p = spec.params
@@ -160,4 +168,5 @@ def compute_metrics(result: SimulationResult) -> dict:
     return {"segments": m["segments"], f"tol_{unit}": spec.tolerance, "hold_s": spec.hold_s,
             "energy_J": m["energy_J"], "electrical_energy_J": m["energy_J"], "heat_J": m["heat_J"],
             "peak_temperature_C": m["peak_temperature_C"],
-            "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations}
+            "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations,
+            "warnings": check(result)}

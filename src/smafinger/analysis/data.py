@@ -38,6 +38,13 @@ ANGLE_RANGE_DEG = (-180.0, 180.0)
 VOLTAGE_RANGE_V = (0.0, 100.0)
 MAX_TIME_S = 600.0
 
+#: smallest strain span of a strain-temperature curve (0.1 % strain: a transformation shows
+#: as several percent; the sma-thermal-cycling curves span 4.1-4.6 %)
+MIN_STRAIN_SPAN = 1e-3
+#: the middle of the strain span, +- this fraction of it: the band where the transformation
+#: temperatures of the two halves are compared
+MID_BAND = 0.25
+
 #: fewest rows accepted
 MIN_ROWS_KINETICS = 20
 MIN_ROWS_HALF = 5
@@ -170,7 +177,32 @@ def load_strain_curve(path: str | Path) -> StrainCurve:
             f"{_where(path, split + 1, rows[split][0])}: the maximum temperature ({T[split]:g} degC) "
             f"leaves too few points for the {half} half (rows must heat first, then cool; at "
             f"least {MIN_ROWS_HALF} rows each)")
+    _check_transformation(path, T, e, split)
     return StrainCurve(str(path), T, e, s * 1e6, split)
+
+
+def _check_transformation(path, T: np.ndarray, e: np.ndarray, split: int) -> None:
+    """Refuse a curve without a transformation, or one whose halves are swapped.
+
+    A wire transforms at higher temperatures on heating (to austenite, A_S..A_F) than on
+    cooling (to martensite, M_S..M_F): in the middle of the strain span the heating half is
+    hotter. Rows given in reverse time order show the opposite.
+    """
+    span = float(e.max() - e.min())
+    if span < MIN_STRAIN_SPAN:
+        raise DataError(f"{path}: the strain hardly changes (span {span:.3g}; at least {MIN_STRAIN_SPAN:g} "
+                        "needed): no phase transformation to fit")
+    mid = 0.5 * float(e.max() + e.min())
+    band = np.abs(e - mid) <= MID_BAND * span
+    heat, cool = band[:split + 1], band[split:]
+    if not (heat.any() and cool.any()):
+        return
+    t_heat, t_cool = float(T[:split + 1][heat].mean()), float(T[split:][cool].mean())
+    if t_heat < t_cool:
+        raise DataError(f"{path}: the rows look reversed in time: mid-way through its strain change the heating "
+                        f"half (rows 1-{split + 1}, up to the maximum temperature) is at {t_heat:.1f} degC, "
+                        f"below the cooling half's {t_cool:.1f} degC, but a wire transforms at higher "
+                        "temperatures on heating (rows must heat first, then cool)")
 
 
 # ---------------------------------------------------------------------------------------
@@ -274,15 +306,10 @@ def parameter_file_text(values: dict[str, float], base: "str | ParameterSet", na
     way the values are validated (ranges, cross-checks) first: ParameterError if invalid.
     """
     from ..parameters import ParameterSet, get
+    from ..parameters.files import overrides_toml
 
     if isinstance(base, ParameterSet):
         return base.replace(name=name, source=source, **values).to_toml()
     get(base).replace(**values)  # validate
-    lines = ["# smafinger parameter file written by `smafinger identify` (SI units)",
-             f"base = {_q(base)}", f"name = {_q(name)}", f"source = {_q(source)}"]
-    lines += [f"{k} = {float(v)!r}" for k, v in values.items()]
-    return "\n".join(lines) + "\n"
-
-
-def _q(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return overrides_toml(base, {"name": name, "source": source, **values},
+                          "smafinger parameter file written by `smafinger identify` (SI units)")

@@ -109,7 +109,7 @@ def sweep_size(spec: SweepSpec, traces: bool) -> SweepSize:
     profile = spec.base.get("profile")
     n_seg = profile.count(",") + 1 if isinstance(profile, str) else 1
     n_cols = 2 + len(spec.vary) + len(METRIC_COLUMNS) + 4 * n_seg
-    samples = math.floor(_max_t_end(spec) / spec.traces_interval_s) + 1
+    samples = int(min(_max_t_end(spec) / spec.traces_interval_s, 1e18)) + 1  # 1e308 s: refused later, no overflow
     per_sample = 8 + 8 + 4 * (len(TRACE_COLUMNS) - 1) + 4  # t_s, point, float32 signals, run_id
     lhs = 8 * n * len(spec.vary) if spec.mode == "lhs" else 0
     return SweepSize(n, n * n_cols * 8, n * samples * per_sample if traces else 0, n * 45 + lhs)
@@ -313,7 +313,7 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     if not finished.done.all():
         raise RuntimeError(f"internal error: {int((~finished.done).sum())} runs have no result after the sweep")
     failed_total = finished.failed_count()
-    _merge(spec, out, pdir, finished, points, checked, traces)
+    _merge(spec, out, pdir, finished, points, checked, traces, template)
     return SweepReport(out=out, traces_out=traces_path(out) if traces else None, total=total,
                        resumed=done0, ran=ran, failed=failed, wall_s=time.perf_counter() - t_start,
                        backend=backend, failed_total=failed_total, client_s_per_run=client_s)
@@ -346,8 +346,13 @@ def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tu
     return failed, busy / ran if ran else math.nan
 
 
-def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Checked, traces: bool) -> None:
-    """Write ``OUT`` (and its traces) from the finished rows, then remove the parts."""
+def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Checked, traces: bool,
+           template) -> None:
+    """Write ``OUT`` (and its traces) from the finished rows, with their provenance
+    (:mod:`.sweep_provenance`), then remove the parts."""
+    from .. import __version__
+    from .sweep_provenance import sweep_provenance
+
     canonical = json.loads(json.dumps(spec.canonical(), default=str))
     meta = finished.out_meta or {}
     unchanged = (finished.n_parts == 0 and meta.get("spec") == canonical
@@ -357,10 +362,10 @@ def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Che
         if traces:
             samples = max(1, round(_max_t_end(spec) / spec.traces_interval_s) + 1)
             write_traces(traces_path(out), finished, samples,
-                         {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s})
+                         {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s, "version": __version__})
         write_table(out, finished, points, varied, checked.n_segments,
-                    {"varied": varied, "spec": canonical, "version": _version(), "traces": traces,
-                     "motion_threshold_deg": MOTION_THRESHOLD_DEG})
+                    {"varied": varied, "spec": canonical, "version": __version__, "traces": traces,
+                     "motion_threshold_deg": MOTION_THRESHOLD_DEG, "provenance": sweep_provenance(template)})
     if pdir.is_dir():
         for f in pdir.iterdir():
             try:
@@ -389,12 +394,6 @@ def read_results(path: str | Path, with_timing: bool = True):
     if not with_timing and "wall_s" in df.columns:
         df = df.drop(columns=["wall_s"])
     return df
-
-
-def _version() -> str:
-    import smafinger
-
-    return smafinger.__version__
 
 
 __all__ = ["SweepSpec", "SweepSpecError", "SweepSizeError", "SweepInterrupted", "SweepReport", "SweepSize",

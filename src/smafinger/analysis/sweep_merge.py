@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, TRACE_COLUMNS
-from .sweep_store import (META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids,
-                          durable_replace, read_meta, temp_path, traces_path)
+from ..files import atomic_write
+from .sweep_store import META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids, read_meta, traces_path
 
 
 class Source:
@@ -193,18 +193,15 @@ def _conform(table, fields: list[tuple[str, object]]):
 
 
 def _stream(path: Path, schema, blocks) -> None:
-    """Write row groups to a temporary, then :func:`durable_replace` it onto ``path``."""
+    """Write row groups to ``path`` (durably, via a temporary: :func:`~smafinger.files.atomic_write`)."""
     import pyarrow.parquet as pq
 
-    tmp = temp_path(path)
-    try:
-        with pq.ParquetWriter(str(tmp), schema) as w:
+    def write(tmp: str) -> None:
+        with pq.ParquetWriter(tmp, schema) as w:
             for block in blocks:
                 w.write_table(block)
-        durable_replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+
+    atomic_write(path, write, durable=True)
 
 
 def write_table(out: Path, finished: Finished, points, varied: list[str], n_segments: int, meta: dict) -> None:

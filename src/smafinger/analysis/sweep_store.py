@@ -1,9 +1,10 @@
 """Sweep storage: durable part files, resume, and a streaming merge into the final table.
 
-- Every file is written under a temporary name (``.NAME.HOST-PID.RANDOM.tmp``), flushed to
-  disk (``fsync``), renamed, and its folder flushed too, so a finished part survives a
-  crash or a power cut. Temporaries left by a killed process are removed by the next run:
-  only names of this pattern, and only those whose process (on this host) is gone.
+- Every file is written by :func:`smafinger.files.atomic_write` with ``durable=True``: under a
+  temporary name (``.NAME.HOST-PID.RANDOM.tmp``), flushed to disk (``fsync``), renamed, and
+  its folder flushed too, so a finished part survives a crash or a power cut. Temporaries
+  left by a killed process are removed by the next run: only names of this pattern, and only
+  those whose process (on this host) is gone.
 - Finished runs go to ``OUT.parts/part-*.parquet`` (and ``part-*.traces.parquet``, written
   first); the rows file is the 'done' mark.
 - Which runs are finished, and the merge into ``OUT``: :mod:`.sweep_merge`.
@@ -12,22 +13,20 @@
 from __future__ import annotations
 
 import json
-import os
 import re
-import socket
 import time
 import uuid
 from pathlib import Path
 
 import numpy as np
 
+from ..files import HOST as _HOST  # noqa: F401  (the host in temporary names)
+from ..files import LEGACY_TMP_AGE_S, atomic_write, clean_stale_temporaries, fsync_dir  # noqa: F401
+
 META_KEY = b"smafinger.sweep"
 #: points per row group of the table, and the most trace samples per row group of the traces
 TABLE_BLOCK = 65_536
 TRACE_BLOCK_SAMPLES = 1_000_000
-#: a temporary of an older smafinger (no host or pid in its name) is stale after this long
-LEGACY_TMP_AGE_S = 3600.0
-_HOST = re.sub(r"[^A-Za-z0-9_]", "_", socket.gethostname())[:40] or "host"
 
 
 class StoreError(ValueError):
@@ -35,7 +34,7 @@ class StoreError(ValueError):
 
 
 # ---------------------------------------------------------------------------------------
-# durable files
+# file names
 # ---------------------------------------------------------------------------------------
 def parts_dir(out: Path) -> Path:
     return out.with_name(out.name + ".parts")
@@ -44,85 +43,6 @@ def parts_dir(out: Path) -> Path:
 def traces_path(out: Path) -> Path:
     """``results.parquet`` -> ``results.traces.parquet``."""
     return out.with_name(out.stem + ".traces" + out.suffix)
-
-
-def temp_path(path: Path) -> Path:
-    return path.with_name(f".{path.name}.{_HOST}-{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
-
-
-def fsync_dir(folder: Path) -> None:
-    try:
-        fd = os.open(folder, os.O_RDONLY)
-    except OSError:  # pragma: no cover - platforms without directory handles
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
-
-
-def durable_replace(tmp: Path, path: Path) -> None:
-    """Flush ``tmp`` to disk, rename it to ``path``, flush the folder."""
-    with open(tmp, "rb+") as f:
-        os.fsync(f.fileno())
-    os.replace(tmp, path)
-    fsync_dir(path.parent)
-
-
-def durable_write(path: Path, write) -> None:
-    """``write(tmp)`` then :func:`durable_replace`; the temporary is removed on any error."""
-    tmp = temp_path(path)
-    try:
-        write(str(tmp))
-        durable_replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OSError):
-        return True
-    return True
-
-
-def clean_stale_temporaries(folder: Path, names: list[str], now: float | None = None) -> list[Path]:
-    """Remove our temporaries of ``names`` (regular expressions) in ``folder`` whose writer
-    is gone; returns them.
-
-    Ours: ``.NAME.HOST-PID.XXXXXXXX.tmp`` (removed if HOST is this host and PID is not a
-    live process) and ``.NAME.XXXXXXXXXXXX.tmp`` of older versions (removed after
-    :data:`LEGACY_TMP_AGE_S`). Nothing else is touched.
-    """
-    if not folder.is_dir():
-        return []
-    now = time.time() if now is None else now
-    alt = "|".join(names)
-    ours = re.compile(rf"^\.(?:{alt})\.(?P<host>[A-Za-z0-9_]+)-(?P<pid>\d+)\.[0-9a-f]{{8}}\.tmp$")
-    legacy = re.compile(rf"^\.(?:{alt})\.[0-9a-f]{{12}}\.tmp$")
-    removed = []
-    for f in folder.iterdir():
-        m = ours.match(f.name)
-        if m:
-            stale = m["host"] == _HOST and not _pid_alive(int(m["pid"]))
-        else:
-            try:
-                stale = bool(legacy.match(f.name)) and now - f.stat().st_mtime > LEGACY_TMP_AGE_S
-            except OSError:
-                stale = False
-        if stale:
-            try:
-                f.unlink()
-                removed.append(f)
-            except OSError:
-                pass
-    return removed
 
 
 PART_NAMES = [r"part-\d{20}-[0-9a-f]{8}(?:\.traces)?\.parquet"]
@@ -151,10 +71,10 @@ def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
     stem = f"part-{time.time_ns():020d}-{uuid.uuid4().hex[:8]}"
     if traces is not None:
         ttab = pa.table(traces)
-        durable_write(pdir / f"{stem}.traces.parquet", lambda tmp: pq.write_table(ttab, tmp))
+        atomic_write(pdir / f"{stem}.traces.parquet", lambda tmp: pq.write_table(ttab, tmp), durable=True)
     tab = pa.Table.from_pylist(rows)
     path = pdir / f"{stem}.parquet"
-    durable_write(path, lambda tmp: pq.write_table(tab, tmp))
+    atomic_write(path, lambda tmp: pq.write_table(tab, tmp), durable=True)
     return path
 
 

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import math
+import os
 import threading
 import time
 from dataclasses import dataclass
+from pathlib import PurePath
 
 import numpy as np
 from numba import typeof
@@ -13,13 +15,14 @@ from numba import typeof
 from ..control.strategies import STRATEGIES, enable_mask
 from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
-from ..profiles import ProfileError, TargetProfile, VoltageProgram
+from ..progress import Display
+from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
 from . import integrators
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
-from .signals import kernel_views, new_outputs
+from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
 
 DEFAULT_DT_S = 1e-3
 #: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
@@ -61,7 +64,15 @@ class RunSpec:
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
               t_end_s=20.0, dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S,
               tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage") -> RunSpec:
-    """A validated :class:`RunSpec` (see :func:`simulate` for the arguments)."""
+    """A validated :class:`RunSpec` (see :func:`simulate` for the arguments).
+
+    Raises ``TypeError`` for an argument of the wrong type and ``ValueError`` (or its
+    subclasses ``ParameterError``, ``ProfileError``) for a bad value, in one line naming the
+    argument and the value.
+    """
+    _check_types(params=params, strategy=strategy, profile=profile, voltage=voltage, t_end_s=t_end_s,
+                 dt_s=dt_s, method=method, output_interval_s=output_interval_s, tol_deg=tol_deg,
+                 hold_s=hold_s, independent_wait=independent_wait, tol_m=tol_m, drive=drive)
     p = resolve(params)
     if strategy not in STRATEGIES:
         raise ValueError(f"strategy = {strategy!r} is not one of {', '.join(STRATEGIES)}")
@@ -88,6 +99,63 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
                    float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m))
     kernel_args(spec)  # validates the times, targets and program against the mechanism
     return spec
+
+
+#: make_spec arguments -> (accepted types, what to give)
+_NUMBER = "a number"
+_ARG_TYPES = {
+    "params": ((str, PurePath, ParameterSet), "a set's name, a .toml path or a ParameterSet"),
+    "strategy": ((str,), f"one of {', '.join(STRATEGIES)}"),
+    "profile": ((str, TargetProfile, type(None)), 'a profile text such as "0:-25,reach:-55" or a TargetProfile'),
+    "voltage": ((str, VoltageProgram, type(None)), 'a program text such as "0:8:0,6:0:0" or a VoltageProgram'),
+    "method": ((str,), f"one of {', '.join(integrators.INTEGRATORS)}"),
+    "drive": ((str,), f"one of {', '.join(DRIVE_KINDS)}"),
+    "independent_wait": ((bool, np.bool_), "True or False"),
+}
+
+
+def _check_types(**args) -> None:
+    """``TypeError`` naming the first argument of the wrong type (numbers: not bool, not text)."""
+    for name, value in args.items():
+        if name in _ARG_TYPES:
+            types, want = _ARG_TYPES[name]
+            ok = isinstance(value, types)
+        else:
+            want = _NUMBER
+            ok = (isinstance(value, (int, float, np.integer, np.floating))
+                  and not isinstance(value, (bool, np.bool_)))
+        if not ok:
+            raise TypeError(f"{name} = {value!r} is not {want}")
+    if args["drive"] not in DRIVE_KINDS:
+        raise ValueError(f"drive = {args['drive']!r} is not one of {', '.join(DRIVE_KINDS)}")
+
+
+def memory_limit_bytes() -> int:
+    """The most memory one run's recorded outputs may take: half of this machine's memory
+    (4 GiB where it cannot be read)."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - platforms without sysconf
+        return 4 * 2**30
+
+
+def output_size(spec: RunSpec, run: RunSettings) -> tuple[int, int, int]:
+    """(samples, signals, bytes) a run records; bytes counts the recorded arrays and one copy
+    of them (as exporting the result makes: a table, a file)."""
+    samples = run.t_end_ticks // run.out_ticks + 1
+    signals = len(MECHANISM_FIELDS) + len(spec.params.wire_names) * len(WIRE_FIELDS)
+    return samples, signals, 2 * 8 * samples * signals
+
+
+def _check_output_size(spec: RunSpec, run: RunSettings) -> None:
+    samples, signals, need = output_size(spec, run)
+    limit = memory_limit_bytes()
+    if need > limit:
+        raise ValueError(
+            f"output_interval_s = {spec.output_interval_s!r} s over t_end_s = {spec.t_end_s!r} s records "
+            f"{samples:,} samples x {signals} signals, about {need / 2**30:,.1f} GiB with one copy for export: "
+            f"more than the {limit / 2**30:.1f} GiB allowed (half of this machine's memory); record less "
+            "often (a longer output interval) or simulate less time")
 
 
 def _segments(spec: RunSpec) -> Segments:
@@ -147,6 +215,7 @@ def kernel_args(spec: RunSpec) -> dict:
         update_ticks=to_ticks("controller_update_s", p.controller_update_s, allow_zero=True),
         pwm_ticks=to_ticks("pwm_period_s", p.pwm_period_s),
         tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True))
+    _check_output_size(spec, run)
     model = build_model(p)
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
@@ -179,8 +248,13 @@ def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tupl
     return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
 
 
-def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
-    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`."""
+def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
+    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
+
+    ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
+    :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
+    a thread, so that Ctrl-C is answered at once).
+    """
     args = kernel_args(spec)
     run = args["run"]
     n_wires = len(spec.params.wire_names)
@@ -191,8 +265,8 @@ def run_spec(spec: RunSpec, progress: bool = False) -> SimulationResult:
     call_args = _kernel_args_tuple(args, mech, wires, seg_actual, seg_reached)
     kernel = _kernels((spec.params.mechanism, n_wires), call_args)  # compiles outside the timing
     t0 = time.perf_counter()
-    if progress:
-        counters, state, t_fail = _run_with_progress(lambda: kernel(*call_args), mech, spec.t_end_s)
+    if progress is True or isinstance(progress, Display):
+        counters, state, t_fail = _run_with_progress(lambda: kernel(*call_args), mech, spec.t_end_s, progress)
     else:
         counters, state, t_fail = kernel(*call_args)
     wall = time.perf_counter() - t0
@@ -216,21 +290,28 @@ def describe_state(p: ParameterSet, state) -> str:
     return ", ".join(parts)
 
 
-def _run_with_progress(call, mech, t_end_s):
-    """Run the (nogil) kernel in a thread and show its progress from the output rows."""
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+def _run_with_progress(call, mech, t_end_s, progress):
+    """Run the (nogil) kernel in a thread and show its progress from the output rows.
 
+    ``progress``: ``True`` (a bar on a terminal, plain lines otherwise) or a
+    :class:`smafinger.progress.Display`. The calling thread only waits, so Ctrl-C stops the
+    wait at once (the compiled loop cannot be interrupted: its daemon thread is left to end
+    with the process).
+    """
+    display = progress if isinstance(progress, Display) else Display.auto(True)
     box = []
-    th = threading.Thread(target=lambda: box.append(call()))
-    with Progress(TextColumn("simulating"), BarColumn(), TextColumn("{task.completed:.1f}/{task.total:.1f} s"),
-                  TimeRemainingColumn(), transient=True) as bar:
-        task = bar.add_task("sim", total=t_end_s)
+    th = threading.Thread(target=lambda: box.append(call()), daemon=True)
+    task = display.task("simulating", t_end_s, "s", integer=False)
+    try:
         th.start()
         while th.is_alive():
             th.join(0.1)
             done = mech["t"]
             filled = done[~np.isnan(done)]
-            bar.update(task, completed=float(filled[-1]) if filled.size else 0.0)
+            task.update(completed=float(filled[-1]) if filled.size else 0.0)
+    finally:
+        if display is not progress:
+            display.stop()
     return box[0]
 
 

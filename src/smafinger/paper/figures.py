@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..metrics import window
-from ..results import atomic_write
+from ..files import atomic_write
 
 #: line colour and style of the 1st, 2nd, ... run of a panel
 STYLES = (("tab:blue", "-"), ("tab:orange", "-."), ("tab:green", "--"), ("tab:red", ":"))

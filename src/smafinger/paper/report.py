@@ -11,7 +11,7 @@ from pathlib import Path
 
 from .. import __version__
 from ..parameters import get as get_params
-from ..results import atomic_write
+from ..files import atomic_write
 from .claim import Outcome, Verdict
 from .derived import Run
 from .fig15 import PAPER_REDUCTION, PAPER_S, REACH, REACH_V1

@@ -4,32 +4,31 @@
 worker processes, then writes into the output directory:
 
 - one PNG per figure (``fig07-cdf.png``, ``fig08-h0.png``, ...);
-- ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms);
-- ``summary.json``: per scenario, its definition, ``result.summary()`` and its figure
-  metrics (``derived``), both computed in the worker from the full 1 ms output;
+- ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms),
+  and ``runs/NAME.provenance.json`` (the run's definition; ``samples_every`` says the
+  thinning);
+- ``summary.json``: per scenario, its definition, ``result.summary()``, its figure
+  metrics (``derived``), both computed in the worker from the full 1 ms output, and its
+  ``provenance`` (:mod:`smafinger.provenance`, exact);
 - ``investigation.json``: the Fig. 15 readings of smafinger 0.1 and the studies' tables
   (:mod:`.studies`, :mod:`.issue10`), when both v1 on-reach Fig. 15 scenarios ran;
 - ``report.md``: each claim beside smafinger's value and verdict (:mod:`.report`).
 
 Each file is written atomically; JSON numbers are rounded to :data:`JSON_DIGITS`
-significant digits.
+significant digits, except in the provenance (exact: a run can be made again).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import fnmatch
-import json
-import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
-import numpy as np
-
 from ..engine.run import RunSpec
-from ..results import SimulationResult, atomic_write
+from ..files import JSON_DIGITS, json_ready, write_json  # noqa: F401  (json_ready re-exported)
+from ..results import SimulationResult
 from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
@@ -40,9 +39,6 @@ from .report import write_report
 
 #: keep every EVERY-th output sample (1 ms) in the CSVs and the figures (10 ms)
 EVERY = 10
-#: significant digits of the numbers in the JSON outputs: float noise goes, and a time below
-#: 1000 s keeps the engine's 1 ns clock
-JSON_DIGITS = 12
 
 
 @dataclass(frozen=True)
@@ -109,26 +105,6 @@ def select(only: Iterable[str] | None) -> list[scn.Scenario]:
     return [scn.get(n) for n in scn.names() if n in chosen]
 
 
-def json_ready(obj: Any, digits: int = JSON_DIGITS) -> Any:
-    """``obj`` with every float rounded to ``digits`` significant digits, non-finite ones
-    as ``None`` and numpy scalars and arrays as Python values."""
-    if isinstance(obj, dict):
-        return {k: json_ready(v, digits) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple, np.ndarray)):
-        return [json_ready(v, digits) for v in obj]
-    if isinstance(obj, (np.integer, np.bool_)):
-        return obj.item()
-    if isinstance(obj, (float, np.floating)):
-        x = float(obj)
-        return float(f"{x:.{digits}g}") if math.isfinite(x) else None
-    return obj
-
-
-def write_json(path: Path, obj: Any) -> None:
-    text = json.dumps(json_ready(obj), indent=2)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(text + "\n"))
-
-
 @dataclass
 class ReproduceOutput:
     out_dir: Path
@@ -140,31 +116,44 @@ class ReproduceOutput:
     failed: list[str] = field(default_factory=list)
 
 
-def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress: bool,
+def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress,
               derivations: dict[str, Derivation | None]) -> dict[str, Run]:
-    if not progress:
-        return run_tasks(tasks, workers, derivations=derivations)
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    """:func:`run_tasks` with a progress display (``progress``: a flag or a
+    :class:`~smafinger.progress.Display`)."""
+    from ..progress import Display
 
-    with Progress(TextColumn("[bold]reproduce[/bold] {task.description}"), BarColumn(),
-                  MofNCompleteColumn(), TimeElapsedColumn(), transient=True) as bar:
-        task = bar.add_task("simulating", total=len(tasks))
-        return run_tasks(tasks, workers, lambda key: bar.update(task, advance=1, description=key), derivations)
+    display = progress if isinstance(progress, Display) else Display.auto(bool(progress))
+    if not display.enabled:
+        return run_tasks(tasks, workers, derivations=derivations)
+    task = display.task("reproduce", len(tasks), "runs")
+    try:
+        return run_tasks(tasks, workers, lambda key: task.update(advance=1, note=key), derivations)
+    finally:
+        if display is not progress:
+            display.stop()
 
 
 def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
-    """``runs/NAME.csv`` of every scenario run and ``summary.json``."""
+    """``runs/NAME.csv`` (with its provenance sidecar) of every scenario run and
+    ``summary.json`` (numbers rounded, each run's provenance exact)."""
+    from ..export import add_signals
+    from ..files import Outputs
+    from ..provenance import provenance
+
     summary: dict[str, Any] = {}
     for name, r in runs.items():
-        entry: dict[str, Any] = {"scenario": r.scenario.definition()}
+        entry: dict[str, Any] = json_ready({"scenario": r.scenario.definition()})
         if r.ok:
-            r.result.save(out_dir / "runs" / f"{name}.csv")
-            entry.update(r.summary)
-            entry["derived"] = r.derived
+            out = Outputs()
+            add_signals(out, r.result, out_dir / "runs" / f"{name}.csv", scenario=name, samples_every=EVERY)
+            out.commit()
+            entry.update(json_ready(r.summary))
+            entry["derived"] = json_ready(r.derived)
+            entry["provenance"] = provenance(r.spec, scenario=name)
         else:
             entry["error"] = r.error
         summary[name] = entry
-    write_json(out_dir / "summary.json", summary)
+    write_json(out_dir / "summary.json", summary, digits=None)
 
 
 def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:
@@ -178,12 +167,13 @@ def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:
 
 
 def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
-              progress: bool = False, investigate: bool | None = None) -> ReproduceOutput:
+              progress=False, investigate: bool | None = None) -> ReproduceOutput:
     """Run the scenarios and write figures, CSVs, summary.json, investigation.json and
     report.md into ``out_dir``.
 
     ``only``: scenario names or glob patterns (default: all). ``investigate``: run the Fig. 15
-    readings (default: when both on-reach Fig. 15 scenarios are selected).
+    readings (default: when both on-reach Fig. 15 scenarios are selected). ``progress``: a
+    flag or a :class:`~smafinger.progress.Display`.
     """
     from ..engine.batch import available_cores
 

@@ -14,6 +14,7 @@ from typing import Callable
 from . import authors2020, linear_bias_spring, paper2010
 from .base import ParameterSet, field_spec, parse_value
 from .errors import ParameterError
+from .files import from_dict as _from_dict
 from .files import load_toml as _load_toml
 from .mechanisms import MECHANISMS, JointParameters, LinearActuatorParameters
 from .options import ModelOptions
@@ -45,6 +46,11 @@ def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet] = ge
     return _load_toml(path, registry_get)
 
 
+def from_dict(data: dict) -> ParameterSet:
+    """A set from plain values (``to_dict`` plus ``mechanism``, or a parameter file's table)."""
+    return _from_dict(data, get)
+
+
 def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
     """A set from a name, a TOML path, or a set."""
     if isinstance(spec, ParameterSet):
@@ -58,4 +64,4 @@ def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
 
 
 __all__ = ["ParameterError", "ParameterSet", "JointParameters", "LinearActuatorParameters", "ModelOptions",
-           "MECHANISMS", "get", "names", "resolve", "load_toml", "field_spec", "parse_value", "REGISTRY"]
+           "MECHANISMS", "get", "names", "resolve", "load_toml", "from_dict", "field_spec", "parse_value", "REGISTRY"]

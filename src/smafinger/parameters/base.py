@@ -104,7 +104,8 @@ class ParameterSet:
         for f in fields(self):
             if f.name != "options":
                 _check_field(f, getattr(self, f.name))
-                if f.metadata["kind"] == "float":  # an int from a file is stored as a float
+                if f.metadata["kind"] == "float" and not isinstance(getattr(self, f.name), float):
+                    # a whole number (V_H_V = 6 in a file): stored as float, as the compiled records expect
                     object.__setattr__(self, f.name, float(getattr(self, f.name)))
         self._cross_checks()
 

@@ -1,5 +1,8 @@
 """Parameter files (TOML): one set per file, written and read back exactly.
 
+Written here only: a whole set (:func:`to_toml`) or a named set with changes
+(:func:`overrides_toml`).
+
 A file names its mechanism (``mechanism = "joint"``; the default, for files written by
 smafinger 0.1) and either gives every parameter or starts from a named set
 (``base = "paper2010"``) and overrides some. Model options go in an ``[options]`` table (top-level
@@ -8,6 +11,7 @@ option keys, as smafinger 0.1 wrote them, are read too).
 
 from __future__ import annotations
 
+import json
 import tomllib
 from dataclasses import fields
 from pathlib import Path
@@ -21,8 +25,8 @@ from .options import OPTION_NAMES, ModelOptions
 def _toml_value(v: Any) -> str:
     if isinstance(v, bool):
         return "true" if v else "false"
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, str):  # a TOML basic string: JSON's escapes are TOML's (control characters too)
+        return json.dumps(v, ensure_ascii=False).replace("\x7f", "\\u007f")
     return repr(float(v))
 
 
@@ -41,6 +45,14 @@ def to_toml(p: ParameterSet) -> str:
     return "\n".join(lines) + "\n"
 
 
+def overrides_toml(base: str, changes: dict[str, Any], comment: str) -> str:
+    """A parameter file starting from the named set ``base`` with ``changes`` (``name``,
+    ``source``, fields, options), in the order given; ``comment`` is its first line."""
+    lines = [f"# {comment}", f"base = {_toml_value(base)}"]
+    lines += [f"{k} = {_toml_value(v if isinstance(v, (bool, str)) else float(v))}" for k, v in changes.items()]
+    return "\n".join(lines) + "\n"
+
+
 def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
     """Load a parameter file (see the module docstring)."""
     path = Path(path)
@@ -56,6 +68,12 @@ def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> 
         return _from_dict(data, registry_get)
     except ParameterError as exc:
         raise ParameterError(f"{path}: {exc}") from None
+
+
+def from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+    """A set from plain values, laid out as in a parameter file (``mechanism``, ``base``, the
+    fields, options in an ``options`` table or at the top level, as ``to_dict`` gives them)."""
+    return _from_dict(data, registry_get)
 
 
 def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:

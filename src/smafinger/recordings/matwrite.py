@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_write
 from .signals import RecordingError
 
 LAYOUTS = ("signals", "table")
@@ -82,14 +83,23 @@ def write_mat(path, t_s, signals: Mapping[str, np.ndarray], provenance: Mapping 
         the wrong length, two names that make the same MATLAB identifier, a provenance value
         that is not a string or a number, an unknown layout.
     """
-    from scipy.io import savemat
-
-    from .. import __version__
-    from ..results import atomic_write
-
     path = Path(path)
     if path.suffix.lower() != ".mat":
         raise RecordingError(f"write_mat: path {str(path)!r} must end in .mat")
+    mdict, names = mat_variables(t_s, signals, provenance, layout, table_name)
+    atomic_write(path, lambda tmp: save_mat(tmp, mdict))
+    return names
+
+
+def mat_variables(t_s, signals: Mapping[str, np.ndarray], provenance: Mapping | None = None,
+                  layout: str = "signals", table_name: str = "recording") -> tuple[dict, dict[str, str]]:
+    """The MATLAB variables :func:`write_mat` writes, checked: ``(variables, names)``.
+
+    For writers that stage several files together (:class:`smafinger.files.Outputs`): write
+    the variables with :func:`save_mat`.
+    """
+    from .. import __version__
+
     if layout not in LAYOUTS:
         raise RecordingError(f"write_mat: layout {layout!r} is not one of {', '.join(LAYOUTS)}")
     t = _times(t_s)
@@ -105,13 +115,49 @@ def write_mat(path, t_s, signals: Mapping[str, np.ndarray], provenance: Mapping 
     else:
         mdict = {matlab_name(table_name): {"time": t[:, None], **columns}}
     mdict["provenance"] = prov
+    return mdict, names
 
-    def write(tmp: str) -> None:
-        with open(tmp, "wb") as fh:
-            savemat(fh, mdict, format="5", long_field_names=True, do_compression=True, oned_as="column")
 
-    atomic_write(path, write)
-    return names
+def table_variables(columns: Mapping[str, np.ndarray], provenance: Mapping | None = None,
+                    table_name: str = "table") -> dict:
+    """A table without a time axis (e.g. a sweep's, one row per run) as MATLAB variables: one
+    struct ``table_name`` with an N x 1 field per column (numbers as doubles, text as a cell
+    array of strings; ``struct2table(table_name)`` in MATLAB) and the ``provenance`` struct."""
+    from .. import __version__
+
+    if not isinstance(columns, Mapping) or not columns:
+        raise RecordingError("write_mat: columns must be a non-empty dict of name -> values")
+    names = _identifiers(columns, {"provenance", matlab_name(table_name)})
+    n = {len(v) for v in columns.values()}
+    if len(n) != 1:
+        raise RecordingError(f"write_mat: the columns have different lengths {sorted(n)}")
+    fields = {}
+    for name, ident in names.items():
+        v = np.asarray(columns[name])
+        if v.dtype.kind in "biuf":
+            fields[ident] = v.astype(np.float64)[:, None]
+        else:
+            cells = np.empty((len(v), 1), dtype=object)
+            cells[:, 0] = ["" if x is None else str(x) for x in v.tolist()]
+            fields[ident] = cells
+    prov = _provenance({"smafinger_version": __version__, **dict(provenance or {})}, "provenance")
+    return {matlab_name(table_name): fields, "provenance": prov}
+
+
+def save_mat(file: str | Path, mdict: dict) -> None:
+    """Write MATLAB variables (from :func:`mat_variables`) to ``file`` as a v5 ``.mat``.
+
+    The file's 116-byte text header names smafinger instead of the time of writing, so that
+    the same variables always make the same bytes.
+    """
+    from scipy.io import savemat
+
+    from .. import __version__
+
+    with open(file, "wb") as fh:
+        savemat(fh, mdict, format="5", long_field_names=True, do_compression=True, oned_as="column")
+        fh.seek(0)
+        fh.write(f"MATLAB 5.0 MAT-file, written by smafinger {__version__}".ljust(116).encode("ascii"))
 
 
 def _times(t_s) -> np.ndarray:

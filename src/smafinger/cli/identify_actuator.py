@@ -22,18 +22,18 @@ from typing import Callable, List, Optional
 
 import typer
 
-from .analysis import actuator_report as ar
-from .analysis.actuator_fit import FitError, FitSettings, fit_actuator
-from .analysis.bench_runs import RigController, load_closed_loop, load_open_loop
-from .analysis.data import parameter_file_text
-from .analysis.free_params import FreeBox, parse_free
-from .engine.batch import make_pool
-from .engine.pools import BatchError
-from .engine.run import SimulationError
-from .files import temp_path
-from .parameters import REGISTRY, ParameterError, resolve
-from .profiles import ProfileError
-from .recordings import RecordingError, parse_map_options
+from ..analysis import actuator_report as ar
+from ..analysis.actuator_fit import FitError, FitSettings, fit_actuator
+from ..analysis.bench_runs import RigController, load_closed_loop, load_open_loop
+from ..analysis.data import parameter_file_text
+from ..analysis.free_params import FreeBox, parse_free
+from ..engine.batch import make_pool
+from ..engine.pools import BatchError
+from ..engine.run import SimulationError
+from ..files import temp_path
+from ..parameters import REGISTRY, ParameterError, resolve
+from ..profiles import ProfileError
+from ..recordings import RecordingError, parse_map_options
 
 CMD = "smafinger identify actuator"
 _DEFAULTS = FitSettings()

@@ -1,8 +1,5 @@
 """``smafinger sweep SPEC.toml``: a parametric sweep on local cores or a Dask cluster.
 
-Registered by :mod:`smafinger.cli` as ``app.command("sweep")(sweep)``; also runnable alone
-as ``python -m smafinger.cli_sweep SPEC.toml ...``.
-
 Exit status: 0 when the table is written and at least one run succeeded (failed runs are
 rows with ``status = error``, counted on stderr); 3 when every run failed, or with
 ``--strict`` when any did; 2 for bad input (one line naming the field or the address,
@@ -20,27 +17,24 @@ from typing import Optional
 
 import typer
 
-EXIT_RUNS_FAILED = 3
+from .errors import EXIT_RUNS_FAILED, UsageError, command
 
 
-def _fail(msg: str, code: int = 2):
-    first = str(msg).splitlines()[0] if str(msg) else "error"
-    print(f"smafinger: error: {first}", file=sys.stderr)
-    raise typer.Exit(code)
-
-
+@command()
 def sweep(
-    spec: Path = typer.Argument(..., help="sweep spec (TOML): [base], [sweep], [vary]; see docs/sweeps.md",
+    spec: Path = typer.Argument(..., metavar="SPEC.toml", help="sweep spec (TOML): [base], [sweep], [vary]; see docs/sweeps.md",
                                 show_default=False),
-    out: Optional[Path] = typer.Option(None, "--out", "-o",
-                                       help="results table FILE.parquet (default: SPEC_NAME.parquet here); "
+    out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE.parquet",
+                                       help="results table (default: SPEC_NAME.parquet here); "
                                             "finished runs go to FILE.parquet.parts/ until the end"),
-    workers: Optional[int] = typer.Option(None, "--workers", "-w",
+    mat: Optional[Path] = typer.Option(None, "--mat", metavar="FILE.mat",
+                                       help="also write the table for MATLAB: a struct 'sweep' (struct2table) "
+                                            "and its provenance"),
+    workers: Optional[int] = typer.Option(None, "--workers", "-w", metavar="N",
                                           help="local worker processes (default: every core; 1: no pool)"),
-    scheduler: Optional[str] = typer.Option(None, "--scheduler",
-                                            help="run on this Dask cluster, tcp://HOST:PORT: one you trust, "
-                                                 "its workers run pickled code "
-                                                 "(needs pip install 'smafinger[distributed]')"),
+    scheduler: Optional[str] = typer.Option(None, "--scheduler", metavar="tcp://HOST:PORT",
+                                            help="run on this Dask cluster: one you trust, its workers run pickled "
+                                                 "code (needs pip install 'smafinger[distributed]')"),
     connect_timeout: float = typer.Option(10.0, "--connect-timeout", metavar="SECONDS",
                                           help="time allowed to reach the Dask scheduler"),
     traces: bool = typer.Option(False, "--traces/--no-traces",
@@ -60,47 +54,26 @@ def sweep(
     """
     from rich.console import Console
 
-    from .analysis.sweep import SweepInterrupted, SweepSpecError, load_spec, run_sweep
-    from .engine.batch import BatchError, DistributedMissing, SchedulerError, check_scheduler
+    from ..analysis.sweep import load_spec, run_sweep
+    from ..engine.batch import check_scheduler
 
-    if workers is not None and workers < 1:
-        _fail(f"--workers {workers}: must be >= 1")
-    if max_runs < 1:
-        _fail(f"--max-runs {max_runs}: must be >= 1")
-    if not progress_interval > 0:
-        _fail(f"--progress-interval {progress_interval}: must be > 0")
+    _check_options(workers, max_runs, progress_interval, scheduler, mat)
+    sweep_spec = load_spec(spec, max_runs=max_runs)
     if scheduler is not None:
-        if workers is not None:
-            _fail("--workers applies to local runs only; with --scheduler the cluster's workers are used")
-        try:
-            import distributed  # noqa: F401
-        except ImportError:
-            _fail("--scheduler needs dask.distributed, which is not installed: pip install 'smafinger[distributed]'")
-    try:
-        sweep_spec = load_spec(spec, max_runs=max_runs)
-        if scheduler is not None:
-            scheduler = check_scheduler(scheduler, connect_timeout)  # fail fast, before any work
-    except (SweepSpecError, SchedulerError) as exc:
-        _fail(str(exc))
+        scheduler = check_scheduler(scheduler, connect_timeout)  # fail fast, before any work
     console = Console(stderr=True)
     previous = _term_as_interrupt()
     try:
         report = run_sweep(sweep_spec, out, workers=workers, scheduler=scheduler, traces=traces,
                            progress=console.is_terminal, console=console, max_runs=max_runs,
                            connect_timeout_s=connect_timeout, progress_interval_s=progress_interval)
-    except SweepInterrupted as exc:
-        print(f"smafinger: {exc}", file=sys.stderr)
-        raise typer.Exit(130)
-    except KeyboardInterrupt:
-        print("smafinger: interrupted", file=sys.stderr)
-        raise typer.Exit(130)
-    except (SweepSpecError, SchedulerError, DistributedMissing) as exc:
-        _fail(str(exc))
-    except BatchError as exc:
-        _fail(str(exc), code=1)
     finally:
         _restore_term(previous)
-    extra = f" and {report.traces_out}" if report.traces_out else ""
+    if mat is not None:
+        from ..analysis.sweep_provenance import write_table_mat
+
+        write_table_mat(report.out, mat)
+    extra = "".join(f" and {p}" for p in (report.traces_out, mat) if p)
     typer.echo(f"wrote {report.out}{extra}: {report.total} runs ({report.resumed} already done, "
                f"{report.failed_total} failed) in {report.wall_s:.1f} s on {report.backend}")
     if report.failed_total:
@@ -109,6 +82,29 @@ def sweep(
               "(rows with status = error; see their error column)", file=sys.stderr)
         if every or strict:
             raise typer.Exit(EXIT_RUNS_FAILED)
+
+
+def _check_options(workers, max_runs, progress_interval, scheduler, mat) -> None:
+    from ..files import check_output
+
+    if workers is not None and workers < 1:
+        raise UsageError(f"--workers {workers}: must be >= 1")
+    if max_runs < 1:
+        raise UsageError(f"--max-runs {max_runs}: must be >= 1")
+    if not progress_interval > 0:
+        raise UsageError(f"--progress-interval {progress_interval}: must be > 0")
+    if mat is not None:
+        if mat.suffix.lower() != ".mat":
+            raise UsageError(f"--mat {mat}: the file name must end in .mat")
+        check_output(mat, "--mat")
+    if scheduler is not None:
+        if workers is not None:
+            raise UsageError("--workers applies to local runs only; with --scheduler the cluster's workers are used")
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise UsageError("--scheduler needs dask.distributed, which is not installed: "
+                             "pip install 'smafinger[distributed]'") from None
 
 
 def _term_as_interrupt():
@@ -125,11 +121,3 @@ def _term_as_interrupt():
 def _restore_term(previous) -> None:
     if previous is not None:
         signal.signal(signal.SIGTERM, previous)
-
-
-def main() -> None:  # pragma: no cover - thin wrapper
-    typer.run(sweep)
-
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

@@ -1,0 +1,5 @@
+"""``python -m smafinger.cli``: the ``smafinger`` command."""
+
+from . import _console
+
+_console()

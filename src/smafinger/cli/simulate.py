@@ -1,0 +1,133 @@
+"""``smafinger simulate``: one run, its metrics printed, its outputs written together."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_TOL_M
+from .common import Method, Strategy, given, load_params, progress_display, progress_option, refuse
+from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
+
+#: options that define the run (refused with --from; --scenario takes some of them)
+RUN_OPTIONS = ("params", "set_", "scenario", "strategy", "profile", "voltage", "duty", "current", "t_end", "dt",
+               "method", "output_interval", "tol_deg", "tol_m", "hold_s")
+#: options a scenario defines and the command line cannot change
+NOT_WITH_SCENARIO = ("params", "voltage", "duty", "current", "tol_m")
+
+
+@command(interrupted=NOTHING_WRITTEN)
+def simulate(
+    ctx: typer.Context,
+    params: str = typer.Option("paper2010", "--params", metavar="NAME|FILE.toml", help="named set or parameter file"),
+    set_: Optional[List[str]] = typer.Option(None, "--set", metavar="NAME=VALUE", help="override a parameter (repeatable)"),
+    scenario: Optional[str] = typer.Option(None, "--scenario", metavar="NAME",
+                                           help="a named scenario (see 'smafinger scenarios'); --set, --strategy, "
+                                                "--profile, --t-end and the run settings change it"),
+    from_: Optional[Path] = typer.Option(None, "--from", metavar="FILE",
+                                         help="re-run exactly the run a summary .json, a .csv (its .provenance.json), "
+                                              ".parquet or .mat records"),
+    strategy: Strategy = typer.Option("cooperative", "--strategy", help="control strategy"),
+    profile: Optional[str] = typer.Option(
+        None, "--profile", metavar="T:TARGET[:ENABLE],...",
+        help='targets (s; deg for the joint, m for a linear actuator; T may be "reach"; ENABLE auto, none, both '
+             'or a wire)'),
+    voltage: Optional[str] = typer.Option(None, "--voltage", metavar="T:V_1[:V_2],...",
+                                          help="open-loop program [V], one value per wire"),
+    duty: Optional[str] = typer.Option(None, "--duty", metavar="T:D_1[:D_2],...",
+                                       help="open-loop program: duty 0-1 of the supply V_H"),
+    current: Optional[str] = typer.Option(None, "--current", metavar="T:I_1[:I_2],...", help="open-loop program [A]"),
+    t_end: float = typer.Option(20.0, "--t-end", metavar="S", help="simulated time [s]"),
+    dt: float = typer.Option(DEFAULT_DT_S, "--dt", metavar="S", help="integration step [s]"),
+    method: Method = typer.Option(DEFAULT_METHOD, "--method", help="integrator"),
+    output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
+    tol_deg: float = typer.Option(0.5, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
+    tol_m: float = typer.Option(DEFAULT_TOL_M, "--tol-m", metavar="M", help="target tolerance of a linear actuator [m]"),
+    hold_s: float = typer.Option(0.5, "--hold-s", metavar="S", help="time a target must hold within tolerance [s]"),
+    out: Optional[Path] = typer.Option(None, "--out", metavar="FILE",
+                                       help="signals to FILE.csv (+ FILE.provenance.json), .parquet or .mat"),
+    summary: Optional[Path] = typer.Option(None, "--summary", metavar="FILE.json", help="metrics and provenance"),
+    plot: Optional[Path] = typer.Option(None, "--plot", metavar="FILE", help="figure to FILE.png, .pdf or .svg"),
+    progress: Optional[bool] = progress_option(),
+):
+    """Simulate an SMA actuator (the finger joint or a linear bias-spring rig) and report the metrics."""
+    from ..engine.run import SimulationError, run_spec
+    from ..export import add_plot, add_signals, add_summary
+    from ..files import Outputs
+    from ..plausibility import blowup_hint
+
+    _check_outputs(out, summary, plot)
+    spec, extra = _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt,
+                        method, output_interval, tol_deg, tol_m, hold_s)
+    with progress_display(progress) as display:
+        try:
+            result = run_spec(spec, progress=display)
+        except SimulationError as exc:
+            raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
+    outputs = Outputs()
+    if out is not None:
+        add_signals(outputs, result, out, "--out", **extra)
+    if summary is not None:
+        add_summary(outputs, result, summary, "--summary", **extra)
+    if plot is not None:
+        add_plot(outputs, result, plot, "--plot", title=extra.get("scenario"))
+    outputs.commit()
+    from .show import print_run
+
+    print_run(result)
+
+
+def _check_outputs(out: Path | None, summary: Path | None, plot: Path | None) -> None:
+    """Refuse bad output names before anything runs."""
+    from ..export import PLOT_SUFFIXES, SIGNAL_FORMATS, check_suffix, sidecar_path
+    from ..files import check_outputs
+
+    targets = []
+    for path, what, allowed in ((out, "--out", SIGNAL_FORMATS), (summary, "--summary", (".json",)),
+                                (plot, "--plot", PLOT_SUFFIXES)):
+        if path is not None:
+            targets.append((path, what))
+            if check_suffix(path, allowed, what) == ".csv":
+                targets.append((sidecar_path(path), f"{what} (its provenance sidecar)"))
+    check_outputs(targets)
+
+
+def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt, method,
+          output_interval, tol_deg, tol_m, hold_s):
+    """(the run spec, what the outputs record beside it) from the options."""
+    from ..engine.run import make_spec
+
+    if from_ is not None:
+        from ..export import read_provenance
+        from ..provenance import spec_from_provenance
+
+        refuse(ctx, RUN_OPTIONS, f"with --from {from_}: it re-runs the run recorded there")
+        record = read_provenance(from_)
+        same = {k: v for k, v in record.items() if k not in ("smafinger_version", "run", "run_sha256")}
+        return spec_from_provenance(record, f"--from {from_}"), same  # what the first run recorded, as it did
+    programs = [(k, v) for k, v in (("voltage", voltage), ("duty", duty), ("current", current)) if v is not None]
+    if len(programs) > 1:
+        raise UsageError(f"give one drive program, not {' and '.join('--' + k for k, _ in programs)}")
+    if scenario is not None:
+        from .. import scenarios
+
+        refuse(ctx, NOT_WITH_SCENARIO, f"with --scenario {scenario} (it sets them; change parameters with --set)")
+        changed = set(given(ctx, "strategy", "profile", "t_end", "tol_deg", "hold_s"))
+
+        def option(value, flag):  # what the command line changes; None: the scenario's own
+            return value if flag in changed else None
+
+        with reading_input():
+            spec = scenarios.get(scenario).spec(
+                overrides=set_ or [], dt_s=dt, method=method, output_interval_s=output_interval,
+                tol_deg=option(tol_deg, "--tol-deg"), hold_s=option(hold_s, "--hold-s"),
+                strategy=option(strategy, "--strategy"), profile=option(profile, "--profile"),
+                t_end_s=option(t_end, "--t-end"))
+        return spec, {"scenario": scenario}
+    kind, program = programs[0] if programs else ("voltage", None)
+    p = load_params(params, set_)
+    with reading_input():
+        return make_spec(p, strategy, profile, program, t_end, dt, method, output_interval, tol_deg, hold_s,
+                         tol_m=tol_m, drive=kind), {}

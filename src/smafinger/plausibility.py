@@ -1,0 +1,115 @@
+"""Warnings for physically absurd results, from a run's exported signals.
+
+The model integrates whatever it is given: 100 V on the paper's wire gives 1,252 degC, a
+1e6 N/m spring a wire stress of 73 GPa. Neither is an error of the numerics, but no real wire
+survives either. :func:`check` flags, per wire:
+
+- **overheating**: the temperature far above the stress-shifted austenite finish temperature,
+  ``T > A_F(sigma) + OVERHEAT_MARGIN_C`` with ``A_F(sigma) = A_F0 + sigma / c_A`` (Eq. 9).
+  Past A_F the wire is fully austenite; running it much hotter ages or anneals NiTi and only
+  heats the room, so the drive or the heat transfer is likely wrong;
+- **overstress**: the stress above :data:`STRESS_RATING_PA`, the top of the usual rating of
+  NiTi actuator wire in repeated use;
+- **overstrain**: the wire's strain ``sigma / D(xi) + xi eps_R`` (Eq. 7a with theta_T = 0)
+  beyond the recoverable strain eps_R by more than :data:`STRAIN_MARGIN`: the wire would
+  deform plastically, which the model does not describe.
+
+The warnings go into the run's metrics (``warnings``: a list of one-line texts) and so into
+every summary; the command line prints them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: overheating: this far above the stress-shifted A_F [degC]
+OVERHEAT_MARGIN_C = 100.0
+#: overstress: above this wire stress [Pa] (NiTi actuator wire is rated for about 100-200 MPa
+#: in repeated use)
+STRESS_RATING_PA = 200e6
+#: overstrain: this far beyond eps_R [-] (1 % strain)
+STRAIN_MARGIN = 0.01
+
+
+def austenite_finish_C(sigma_Pa: np.ndarray, A_F0_C: float, c_A_Pa_per_C: float) -> np.ndarray:
+    """The stress-shifted austenite finish temperature A_F = A_F0 + sigma / c_A (Eq. 9)."""
+    return A_F0_C + sigma_Pa / c_A_Pa_per_C
+
+
+def wire_strain(sigma_Pa: np.ndarray, xi: np.ndarray, D_A_Pa: float, D_M_Pa: float, eps_R: float) -> np.ndarray:
+    """The wire's strain sigma / D(xi) + xi eps_R (Eq. 7a with theta_T = 0)."""
+    from .model.constitutive import youngs_modulus
+
+    return sigma_Pa / youngs_modulus.py_func(xi, D_A_Pa, D_M_Pa) + xi * eps_R
+
+
+def _peak(values: np.ndarray, t: np.ndarray) -> tuple[float, float]:
+    i = int(np.nanargmax(values))
+    return float(values[i]), float(t[i])
+
+
+def check(result) -> list[str]:
+    """The plausibility warnings of a run (empty: nothing absurd), one line each."""
+    p = result.spec.params
+    t = result.t
+    out = []
+    for w in p.wire_names:
+        T, sigma, xi = result.signal(f"T_{w}_C"), result.signal(f"sigma_{w}_Pa"), result.signal(f"xi_{w}")
+        over, at = _peak(T - austenite_finish_C(sigma, p.A_F0_C, p.c_A_Pa_per_C), t)
+        if over > OVERHEAT_MARGIN_C:
+            out.append(f"{w} wire: {np.nanmax(T):.0f} degC, {over:.0f} degC above its austenite finish "
+                       f"temperature A_F at t = {at:.3g} s: far outside what the wire survives; check the "
+                       "drive (voltage, duty or current) and the heat transfer (h0, h2)")
+        peak, at = _peak(sigma, t)
+        if peak > STRESS_RATING_PA:
+            out.append(f"{w} wire: stress {peak / 1e6:,.0f} MPa at t = {at:.3g} s, above the "
+                       f"{STRESS_RATING_PA / 1e6:.0f} MPa NiTi actuator wire is rated for; check the "
+                       "springs and the load")
+        strain, at = _peak(wire_strain(sigma, xi, p.D_A_Pa, p.D_M_Pa, p.eps_R), t)
+        if strain > p.eps_R + STRAIN_MARGIN:
+            out.append(f"{w} wire: strain {strain:.3g} at t = {at:.3g} s, beyond the recoverable strain "
+                       f"eps_R = {p.eps_R:g} (+{STRAIN_MARGIN:g}): the wire would deform plastically, "
+                       "which the model does not describe")
+    return out
+
+
+# ---------------------------------------------------------------------------------------
+# what to change after a numerical blow-up
+# ---------------------------------------------------------------------------------------
+#: the reference set of each mechanism: a parameter this many times away from it looks extreme
+REFERENCE_SETS = {"joint": "paper2010", "linear-bias-spring": "linear-bias-spring"}
+EXTREME_FACTOR = 10.0
+
+
+def extreme_parameters(params) -> list[str]:
+    """The parameters of a set furthest from its mechanism's reference set (at least
+    :data:`EXTREME_FACTOR` times larger or smaller), furthest first, as ``NAME = VALUE`` texts."""
+    import math
+
+    from .parameters import get
+
+    ref_name = REFERENCE_SETS.get(params.mechanism)
+    if ref_name is None:
+        return []
+    ref = get(ref_name)
+    found = []
+    for name in params.field_names():
+        v, r = getattr(params, name), getattr(ref, name)
+        if isinstance(v, str) or isinstance(v, bool) or not (v > 0 and r > 0):
+            continue
+        factor = max(v / r, r / v)
+        if factor >= EXTREME_FACTOR:
+            found.append((factor, f"{name} = {v:g} ({'%.0f' % factor}x {'above' if v > r else 'below'} "
+                                  f"{ref_name}'s {r:g})"))
+    return [text for factor, text in sorted(found, key=lambda x: -x[0]) if math.isfinite(factor)]
+
+
+def blowup_hint(spec) -> str:
+    """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
+    hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
+    if spec.method != "rk4":
+        hint += " or --method rk4"
+    extreme = extreme_parameters(spec.params)
+    if extreme:
+        hint += f"; check {extreme[0]}"
+    return hint

@@ -1,0 +1,243 @@
+"""Issues 13 and 14 at the command line: refusals are one line with exit 2 and write nothing,
+outputs are all-or-none and say how they were made, a recorded run re-runs byte for byte."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+from scipy.io import loadmat
+
+from smafinger import export
+from smafinger.cli import app, main
+
+QUICK = ["--profile", "0:-25", "--t-end", "1", "--no-progress"]
+
+
+def run(capsys, *argv):
+    rc = main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, [ln for ln in err.splitlines() if ln.strip()]
+
+
+def files(folder: Path) -> list[str]:
+    return sorted(p.name for p in folder.iterdir())
+
+
+@pytest.fixture
+def here(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "d").mkdir()
+    (tmp_path / "f").write_text("x")
+    return tmp_path
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["simulate", "--params", "", *QUICK], "--params '': give a named set"),
+    (["simulate", "--params", "d", *QUICK], "--params d: is a folder"),
+    (["simulate", *QUICK, "--summary", "d"], "--summary d: the file name must end in .json"),
+    (["simulate", *QUICK, "--summary", "d/x/y.json"], "--summary d/x/y.json: folder d/x does not exist"),
+    (["simulate", *QUICK, "--plot", "d"], "--plot d: the file name must end in .png or .pdf or .svg"),
+    (["simulate", *QUICK, "--out", "nofolder/r.csv"], "--out nofolder/r.csv: folder nofolder does not exist"),
+    (["simulate", *QUICK, "--out", "s.csv", "--summary", "s.json", "--plot", "s.foo"], "--plot s.foo"),
+    (["simulate", *QUICK, "--out", "s.csv", "--summary", "s.provenance.json"], "the same file is given for two"),
+    (["params", "paper2010", "--out", "d"], "--out d: is a folder; give a file name"),
+    (["params", ""], "parameter set '': give a named set"),
+    (["reproduce", "--out", "f", "--only", "fig8-h0-60-upper-v1"], "--out f: is a file; give a folder"),
+    (["reproduce", "--out", "o", "--only", "fig99-v1"], "unknown scenario 'fig99-v1'"),
+    (["simulate", "--t-end", "1e308", "--profile", "0:-25"], "t_end_s = 1e+308 s is beyond the clock's range"),
+    (["simulate", "--dt", "1e308", "--profile", "0:-25"], "dt_s = 1e+308 s is beyond the clock's range"),
+    (["simulate", "--hold-s", "1e308", "--profile", "0:-25"], "hold_s = 1e+308 s is beyond the clock's range"),
+    (["simulate", "--strategy", "open-loop", "--voltage", "0:8:0,1e10:0:0", "--t-end", "1"], "voltage start [1]"),
+    (["simulate", "--t-end", "1e6", "--profile", "0:-25"], "1,000,000,001 samples x 29 signals"),
+    (["simulate", "--t-end", "1", "--output-interval", "1e-9", "--profile", "0:-25"], "GiB allowed"),
+    (["simulate", "--scenario", "fig12-extension-v1", "--params", "paper2010"], "--params: not used with --scenario"),
+    (["simulate", "--scenario", "fig12-extension-v1", "--voltage", "0:8:0"], "--voltage: not used with --scenario"),
+    (["simulate", "--strategy", "sideways"], "'sideways' is not one of 'open-loop', 'independent', 'cooperative'"),
+    (["simulate", "--method", "rk5"], "'rk5' is not one of 'euler', 'rk4'"),
+    (["simulate", "--from", "nothing.json"], "--from nothing.json: no such file"),
+    (["sweep", "nothing.toml", "--mat", "x.txt"], "--mat x.txt: the file name must end in .mat"),
+])
+def test_refusals_are_one_line_exit_2_and_write_nothing(here, capsys, argv, needle):
+    before = files(here)
+    rc, _, err = run(capsys, *argv)
+    assert rc == 2 and len(err) == 1 and err[0].startswith("smafinger: error: ") and needle in err[0], err
+    assert files(here) == before and files(here / "d") == []
+
+
+def test_a_failing_output_leaves_none_of_the_others(here, capsys, monkeypatch):
+    def broken(fig, tmp, fmt):
+        Path(tmp).write_bytes(b"half a png")
+        raise OSError(28, "No space left on device", tmp)
+
+    monkeypatch.setattr(export, "_save_figure", broken)
+    rc, _, err = run(capsys, "simulate", *QUICK, "--out", "s.csv", "--summary", "s.json", "--plot", "s.png")
+    assert rc == 1 and len(err) == 1 and "No space left on device" in err[0]
+    assert files(here) == ["d", "f"]
+
+
+def test_a_scenario_takes_the_run_options_it_can_and_refuses_the_others(here, capsys):
+    rc, out, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "2", "--summary", "s.json",
+                     "--set", "M_SF_Nm=0.02", "--no-progress")
+    s = json.loads((here / "s.json").read_text())
+    assert rc == 0 and s["t_end_s"] == 2.0 and s["provenance"]["scenario"] == "fig12-extension-v1"
+    assert s["provenance"]["run"]["parameters"]["M_SF_Nm"] == 0.02
+    assert s["provenance"]["run"]["parameters"]["friction_sticking"] == "initial-only"  # the scenario's own
+    rc, _, err = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--tol-m", "1e-3")
+    assert rc == 2 and "--tol-m: not used with --scenario" in err[0]
+
+
+def test_warnings_are_printed_and_recorded(here, capsys):
+    rc, _, err = run(capsys, "simulate", "--strategy", "open-loop", "--voltage", "0:100:0", "--t-end", "3",
+                     "--summary", "hot.json", "--no-progress")
+    assert rc == 0 and len(err) == 1 and err[0].startswith("smafinger: warning: upper wire: 1252 degC")
+    assert json.loads((here / "hot.json").read_text())["warnings"] == [err[0].removeprefix("smafinger: warning: ")]
+    rc, _, err = run(capsys, "simulate", "--set", "spring_K_N_m=1e6", "--strategy", "open-loop", "--voltage",
+                     "0:8:0", "--t-end", "1", "--no-progress")
+    assert rc == 0 and any("stress 72,776 MPa" in e for e in err) and any("recoverable strain" in e for e in err)
+
+
+def test_a_blow_up_says_what_to_change(capsys):
+    rc, _, err = run(capsys, "simulate", "--params", "paper2010-table2", "--set", "inertia_kg_m2=1e-9", "--strategy",
+                     "open-loop", "--voltage", "0:8:0,10:0:0", "--method", "euler", "--t-end", "20", "--no-progress")
+    assert rc == 1 and len(err) == 1 and err[0].startswith("smafinger: simulation failed: numerical blow-up at t = ")
+    assert "try a smaller --dt (now 0.001 s) or --method rk4; check inertia_kg_m2 = 1e-09" in err[0]
+
+
+def test_json_times_carry_no_float_noise(here, capsys):
+    assert run(capsys, "simulate", "--profile", "0:-25,reach:-55", "--t-end", "15", "--summary", "s.json",
+               "--no-progress")[0] == 0
+    text = (here / "s.json").read_text()
+    s = json.loads(text)
+    times = [seg[k] for seg in s["segments"] for k in ("start_s", "reached_s", "end_s") if seg[k] is not None]
+    assert times and all(len(repr(t).replace(".", "").lstrip("0")) <= 13 for t in times), times
+    assert "0000000000" not in text.split('"provenance"')[0] and "9999999999" not in text.split('"provenance"')[0]
+
+
+# ---- re-running a recorded run --------------------------------------------------------------------
+def test_from_a_summary_re_runs_byte_for_byte(here, capsys):
+    run_options = ["--params", "authors2020", "--set", "M_SF_Nm=0.0123", "--strategy", "independent", "--profile",
+                   "0:-25:upper,reach:-40", "--t-end", "6", "--dt", "5e-4", "--output-interval", "0.002", "--no-progress"]
+    for fmt in ("csv", "parquet", "mat"):  # the first run, in every format
+        assert run(capsys, "simulate", *run_options, "--out", f"a.{fmt}", "--summary", f"a_{fmt}.json")[0] == 0
+    for source in ("a_csv.json", "a.csv", "a.parquet", "a.mat"):
+        stem = "b_" + source.replace(".", "_")
+        for fmt in ("csv", "parquet", "mat"):
+            rc, _, err = run(capsys, "simulate", "--from", source, "--out", f"{stem}.{fmt}", "--summary",
+                             f"{stem}.json", "--no-progress")
+            assert rc == 0, err
+            assert (here / f"{stem}.{fmt}").read_bytes() == (here / f"a.{fmt}").read_bytes(), (source, fmt)
+        assert (here / f"{stem}.provenance.json").read_bytes() == (here / "a.provenance.json").read_bytes()
+        a, b = (json.loads((here / n).read_text()) for n in ("a_csv.json", f"{stem}.json"))
+        assert a.pop("wall_s") > 0 and b.pop("wall_s") > 0  # the loop's time on this machine: the one difference
+        assert a == b
+
+
+def test_a_scenario_run_again_records_its_scenario(here, capsys):
+    assert run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "3", "--out", "a.csv",
+               "--no-progress")[0] == 0
+    assert run(capsys, "simulate", "--from", "a.csv", "--out", "b.csv", "--no-progress")[0] == 0
+    assert (here / "b.provenance.json").read_bytes() == (here / "a.provenance.json").read_bytes()
+    assert json.loads((here / "b.provenance.json").read_text())["scenario"] == "fig12-extension-v1"
+    assert (here / "b.csv").read_bytes() == (here / "a.csv").read_bytes()
+
+
+def test_mat_output_holds_every_signal_and_the_provenance(here, capsys):
+    assert run(capsys, "simulate", *QUICK, "--out", "r.mat")[0] == 0
+    assert run(capsys, "simulate", *QUICK, "--out", "r.csv")[0] == 0
+    m = loadmat(here / "r.mat", squeeze_me=True)
+    df = pd.read_csv(here / "r.csv")
+    for c in df.columns[1:]:
+        np.testing.assert_allclose(m[c]["signals"][()]["values"][()], df[c], rtol=1e-8, atol=1e-12)
+    np.testing.assert_allclose(m["theta_deg"]["time"][()], df["t_s"], atol=1e-12)
+    assert json.loads(str(m["provenance"]["run_json"][()]))["t_end_s"] == 1.0
+
+
+# ---- the command line itself ------------------------------------------------------------------------
+def test_help_lists_the_allowed_values(capsys):
+    assert main(["simulate", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert "<open-loop|independent|cooperative>" in text and "<euler|rk4>" in text and "<str>" not in text
+    assert main(["identify", "kinetics", "--help"]) == 0
+    assert "<mean|row>" in capsys.readouterr().out
+
+
+def test_every_command_is_mounted_explicitly():
+    names = {c.name for c in app.registered_commands} | {g.name for g in app.registered_groups}
+    assert names == {"simulate", "params", "scenarios", "reproduce", "sweep", "identify"}
+    from smafinger.cli.identify import app as identify
+
+    assert {c.callback.__name__ for c in identify.registered_commands} == {"kinetics", "joint"}
+
+
+def test_no_arguments_prints_the_help(capsys):
+    assert main([]) == 0 and "Commands:" in capsys.readouterr().out
+    assert main(["identify"]) == 0 and "kinetics" in capsys.readouterr().out
+
+
+def test_ctrl_c_exits_130_with_one_line_at_once(tmp_path):
+    """Ctrl-C in the middle of a run of 1e6 s (over 10^9 steps: minutes on any machine) is
+    answered at once, not when the compiled loop ends."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, "-m", "smafinger.cli", "simulate", "--profile", "0:-25", "--t-end",
+                             "1e6", "--output-interval", "10", "--out", "r.csv", "--progress"],
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        first = proc.stderr.readline()  # the first progress line: the run is under way
+        assert first.startswith("simulating: "), first
+        proc.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        out, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert time.monotonic() - t0 < 60.0  # the run itself needs several minutes more
+    lines = [ln for ln in err.splitlines() if ln.strip() and not ln.startswith("simulating: ")]
+    assert proc.returncode == 130 and lines == ["smafinger: interrupted (Ctrl-C); no output was written"], err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sweep_writes_a_matlab_table_with_provenance(tmp_path, capsys):
+    spec = tmp_path / "s.toml"
+    spec.write_text('[base]\nparams = "paper2010-table2"\nstrategy = "open-loop"\nvoltage = "0:8:0,2:0:0"\n'
+                    't_end_s = 3.0\n[vary]\nh0_heating_W_m2K = [60.0, 70.0]\n')
+    rc, out, err = run(capsys, "sweep", str(spec), "--out", str(tmp_path / "s.parquet"), "--mat",
+                       str(tmp_path / "s.mat"), "--workers", "1")
+    assert rc == 0, err
+    table = pd.read_parquet(tmp_path / "s.parquet")
+    m = loadmat(tmp_path / "s.mat", squeeze_me=True)
+    assert list(m["sweep"]["h0_heating_W_m2K"][()]) == [60.0, 70.0]
+    assert list(m["sweep"]["run_id"][()]) == table["run_id"].tolist()
+    prov = json.loads(str(m["provenance"]["provenance_json"][()]))
+    assert prov["base_parameters"]["name"] == "paper2010-table2" and prov["base_run_settings"]["dt_s"] == 1e-3
+    meta = json.loads(pq.read_schema(tmp_path / "s.parquet").metadata[b"smafinger.sweep"])
+    assert meta["provenance"] == prov
+
+
+def test_a_parameter_file_without_name_source_or_base_is_complete_enough(here, capsys):
+    from smafinger.parameters import get
+
+    for mech in ("paper2010", "linear-bias-spring"):
+        text = "\n".join(ln for ln in get(mech).to_toml().splitlines() if not ln.startswith(("name", "source")))
+        (here / "p.toml").write_text(text + "\n")
+        args = ["--profile", "0:-25"] if mech == "paper2010" else ["--strategy", "open-loop", "--voltage", "0:8"]
+        rc, out, err = run(capsys, "simulate", "--params", "p.toml", *args, "--t-end", "0.5", "--summary", "s.json",
+                           "--no-progress")
+        assert rc == 0, err
+        assert json.loads((here / "s.json").read_text())["provenance"]["run"]["parameters"]["name"] == "custom"
+        assert run(capsys, "params", "p.toml")[1].splitlines()[2] == 'name = "custom"  # name of the set'
+
+
+def test_a_sweep_of_another_mechanism_is_refused_before_any_run(tmp_path, capsys):
+    spec = tmp_path / "lin.toml"
+    spec.write_text('[base]\nparams = "linear-bias-spring"\nstrategy = "open-loop"\nvoltage = "0:8,2:0"\n'
+                    't_end_s = 3.0\n[vary]\nbias_spring_K_N_m = [100.0, 200.0]\n')
+    rc, _, err = run(capsys, "sweep", str(spec), "--out", str(tmp_path / "t.parquet"), "--workers", "1")
+    assert rc == 2 and len(err) == 1 and "is a linear-bias-spring set; sweeps tabulate the finger joint only" in err[0]
+    assert files(tmp_path) == ["lin.toml"]

@@ -1,0 +1,155 @@
+"""Issue 13: every output says how it was made, a run can be made again from it exactly,
+and physically absurd results carry warnings."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.io import loadmat
+
+from smafinger import __version__, simulate
+from smafinger.engine.run import make_spec, run_spec
+from smafinger.parameters import get
+from smafinger.export import PARQUET_KEY, read_provenance, sidecar_path
+from smafinger.plausibility import OVERHEAT_MARGIN_C, STRESS_RATING_PA, austenite_finish_C, check, wire_strain
+from smafinger.provenance import (ProvenanceError, definition_hash, provenance, run_definition,
+                                  spec_from_definition, spec_from_provenance)
+
+
+# ---- run definitions ---------------------------------------------------------------------------
+@pytest.mark.parametrize("args, kw", [
+    (("paper2010", "cooperative", "0:-25,reach:-55:both,reach:-40"), {}),
+    (("authors2020", "independent", "0:-25:upper,5:-40:none"), dict(independent_wait=False, tol_deg=0.1)),
+    (("paper2010-table2", "open-loop", None, "0:8:0,6:0:0"), dict(dt_s=5e-4, method="euler")),
+    (("linear-bias-spring", "open-loop", None, "0:0.25,3:0"), dict(drive="duty", tol_m=1e-4)),
+    (("linear-bias-spring", "open-loop", None, "0:0.2,2:0"), dict(drive="current")),
+])
+def test_a_definition_rebuilds_the_same_spec(args, kw):
+    spec = make_spec(*args, t_end_s=4.0, **kw)
+    record = json.loads(json.dumps(provenance(spec)))  # through JSON text, as written
+    assert record["smafinger_version"] == __version__
+    assert spec_from_provenance(record) == spec
+    assert record["run_sha256"] == definition_hash(run_definition(spec))
+
+
+@given(h0=st.floats(0.0, 1e4), msf=st.floats(0.0, 1.0), t_end=st.integers(1, 10_000).map(lambda k: k * 1e-3),
+       target=st.floats(-55.0, -25.0))
+@settings(max_examples=40, deadline=None)
+def test_any_overridden_set_round_trips_exactly(h0, msf, t_end, target):
+    p = get("paper2010").replace(h0_heating_W_m2K=h0, M_SF_Nm=msf)
+    spec = make_spec(p, "cooperative", f"0:{target!r}", t_end_s=t_end, output_interval_s=t_end)
+    again = spec_from_definition(json.loads(json.dumps(run_definition(spec))))
+    assert again == spec and again.params.h0_heating_W_m2K == h0
+
+
+def test_an_edited_definition_is_refused():
+    record = json.loads(json.dumps(provenance(make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0))))
+    record["run"]["parameters"]["M_SF_Nm"] = 0.02
+    with pytest.raises(ProvenanceError, match="does not match run_sha256"):
+        spec_from_provenance(record)
+    for broken, message in [({"schema": 99}, "schema 99"), ({**record["run"], "dt_s": "fast"}, "dt_s = 'fast'"),
+                            ({k: v for k, v in record["run"].items() if k != "method"}, "missing method"),
+                            ({**record["run"], "drive": [1]}, r"drive = \[1\]")]:
+        with pytest.raises(ProvenanceError, match=message):
+            spec_from_definition(broken)
+
+
+# ---- the outputs carry it ------------------------------------------------------------------------
+def test_every_signal_format_and_the_summary_carry_the_provenance(tmp_path):
+    r = simulate("paper2010", "cooperative", "0:-25", t_end_s=1.0, output_interval_s=0.01)
+    want = provenance(r.spec)
+    for name in ("r.csv", "r.parquet", "r.mat"):
+        r.save(tmp_path / name)
+    r.write_summary(tmp_path / "s.json")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.mat", "r.parquet", "r.provenance.json", "s.json"]
+    assert sidecar_path(tmp_path / "r.csv") == tmp_path / "r.provenance.json"
+    assert list(pd.read_csv(tmp_path / "r.csv").columns) == r.column_names  # plain CSV: readable as is
+    assert json.loads(pq.read_schema(tmp_path / "r.parquet").metadata[PARQUET_KEY]) == want
+    assert list(pd.read_parquet(tmp_path / "r.parquet").columns) == r.column_names
+    mat = loadmat(tmp_path / "r.mat", squeeze_me=True)
+    assert str(mat["provenance"]["run_sha256"][()]) == want["run_sha256"]
+    assert str(mat["provenance"]["smafinger_version"][()]) == __version__
+    np.testing.assert_array_equal(mat["theta_deg"]["signals"][()]["values"][()], r.theta_deg)
+    summary = json.loads((tmp_path / "s.json").read_text())
+    assert summary["provenance"] == want and summary["warnings"] == []
+    for name in ("r.csv", "r.provenance.json", "r.parquet", "r.mat", "s.json"):
+        assert read_provenance(tmp_path / name)["run_sha256"] == want["run_sha256"]
+        assert spec_from_provenance(read_provenance(tmp_path / name)) == r.spec
+
+
+def test_the_same_run_makes_the_same_bytes(tmp_path):
+    r = simulate("authors2020", "cooperative", "0:-25,reach:-40", t_end_s=3.0)
+    again = run_spec(spec_from_provenance(read_provenance_of(r, tmp_path)))
+    for i, res in enumerate((r, again)):
+        for suffix in (".csv", ".parquet", ".mat"):
+            res.save(tmp_path / f"{i}{suffix}")
+    for suffix in (".csv", ".provenance.json", ".parquet", ".mat"):
+        assert (tmp_path / f"0{suffix}").read_bytes() == (tmp_path / f"1{suffix}").read_bytes(), suffix
+
+
+def read_provenance_of(result, folder):
+    result.write_summary(folder / "first.json")
+    return read_provenance(folder / "first.json")
+
+
+def test_files_without_a_definition_are_refused(tmp_path):
+    (tmp_path / "x.json").write_text('{"segments": []}')
+    (tmp_path / "y.csv").write_text("t_s\n0\n")
+    (tmp_path / "z.parquet").write_bytes(b"PAR1 not really")
+    for name, message in [("x.json", "holds no smafinger run definition"), ("y.csv", "holds no smafinger"),
+                          ("z.parquet", "cannot be read"), ("nope.json", "no such file")]:
+        with pytest.raises(ProvenanceError, match=message):
+            read_provenance(tmp_path / name)
+
+
+# ---- plausibility --------------------------------------------------------------------------------
+def test_equations_of_the_checks():
+    assert austenite_finish_C(np.array([0.0, 10.3e6]), 110.0, 10.3e6).tolist() == [110.0, 111.0]
+    eps = wire_strain(np.array([0.0, 75e6, 28e6]), np.array([1.0, 0.0, 1.0]), 75e9, 28e9, 0.023)
+    np.testing.assert_allclose(eps, [0.023, 1e-3, 0.024])
+
+
+def test_absurd_drive_and_spring_give_warnings_sane_runs_none():
+    hot = simulate("paper2010", "open-loop", voltage="0:100:0", t_end_s=3.0)
+    (w,) = hot.metrics["warnings"]
+    assert w.startswith("upper wire: 1252 degC") and "above its austenite finish temperature" in w
+    stiff = simulate(resolve_with("spring_K_N_m=1e6"), "open-loop", voltage="0:8:0", t_end_s=2.0)
+    texts = " | ".join(stiff.metrics["warnings"])
+    assert "upper wire: stress" in texts and "lower wire: stress" in texts and "beyond the recoverable strain" in texts
+    for run in (simulate("paper2010", "cooperative", "0:-25,reach:-55,reach:-40", t_end_s=30.0),
+                simulate("authors2020", "independent", "0:-25:upper,5:-55:both", t_end_s=20.0),
+                simulate("linear-bias-spring", "open-loop", voltage="0:8,10:0", t_end_s=20.0)):
+        assert run.metrics["warnings"] == [], run.metrics["warnings"]
+        assert run.summary()["warnings"] == []
+
+
+def test_thresholds_are_applied_at_their_values():
+    r = simulate("paper2010", "open-loop", voltage="0:8:0", t_end_s=2.0)
+    assert check(r) == []
+    peak_over = float(np.max(r.T_upper_C - austenite_finish_C(r.sigma_upper_Pa, 110.0, 10.3e6)))
+    assert peak_over < OVERHEAT_MARGIN_C and float(np.max(r.sigma_upper_Pa)) < STRESS_RATING_PA
+
+
+def resolve_with(*overrides):
+    return get("paper2010").with_overrides(list(overrides))
+
+
+def test_no_scenario_of_the_paper_gives_a_warning():
+    from smafinger.paper import scenarios
+
+    for s in scenarios.all_scenarios():
+        r = run_spec(s.spec())
+        assert r.metrics["warnings"] == [], (s.name, r.metrics["warnings"])
+
+
+def test_sweep_run_ids_take_any_number_of_wires_and_keep_the_joint_text():
+    from smafinger.analysis.sweep_spec import canonical_run, run_id
+
+    joint = make_spec("paper2010-table2", "open-loop", None, "0:8:0,8:0:0", t_end_s=1.0)
+    assert canonical_run(joint)["voltage"] == "0.0:8.0:0.0,8.0:0.0:0.0"  # the text run ids were made from
+    rig = make_spec("linear-bias-spring", "open-loop", None, "0:8,2:0", t_end_s=3.0)
+    assert canonical_run(rig)["voltage"] == "0.0:8.0,2.0:0.0" and len(run_id(rig)) == 16
