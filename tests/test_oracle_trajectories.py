@@ -91,9 +91,6 @@ def test_engine_trajectory_matches_scipy_oracle(p, program, kind, t_end, tol_q, 
     assert (err["q"] <= tol_q and err["T"] <= tol_T and err["xi"] <= tol_xi and err["T_case"] <= tol_case), err
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "damping_switch = 'heating-value' (options.py: 'the heating value throughout') is not implemented: "
-    "control/controller.py viscous_coefficient reads it as 'heating-phase' (C_DF cooling once the drive is off)"))
 def test_heating_value_damping():
     """8 V for 6 s then off: the return uses C_DF heating (0.03). Measured: q differs by 6.7 deg."""
     err, ref = trajectory_errors(JOINT.replace(damping_switch="heating-value"), "0:8:0,6:0:0", "voltage", 20.0)

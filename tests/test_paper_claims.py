@@ -160,9 +160,6 @@ def test_fig15_v1_independent_uses_the_antagonist_for_the_return(runs):
     assert np.all(r.signal("enabled_upper")[back] == 0.0)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine: control/controller.py viscous_coefficient treats damping_switch = heating-value as heating-phase; "
-    "the Fig. 15 study sets one C_DF through C_DF_cooling_Nms instead"))
 def test_heating_value_rule_is_one_damping_coefficient():
     s = scenarios.get("fig13-extension-case1-v1")
     rule = run_spec(s.spec(["damping_switch=heating-value"]))

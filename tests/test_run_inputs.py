@@ -11,6 +11,7 @@ from smafinger import simulate
 from smafinger.engine import run as engine_run
 from smafinger.engine.clock import MAX_S, MAX_TICKS, TICK_S, ticks_array, to_ticks
 from smafinger.engine.run import make_spec
+from smafinger.engine.signals import MECHANISM_FIELDS, WIRE_FIELDS
 
 
 # ---- the clock -------------------------------------------------------------------------------
@@ -51,9 +52,15 @@ def test_huge_times_are_value_errors_not_overflow(kw):
 
 
 # ---- the output size -------------------------------------------------------------------------
+#: the joint's recorded signals: the mechanism's and each of its two wires' (engine/signals.py)
+JOINT_SIGNALS = len(MECHANISM_FIELDS) + 2 * len(WIRE_FIELDS)
+
+
 @pytest.mark.parametrize("kw", [dict(t_end_s=1e6), dict(t_end_s=1.0, output_interval_s=1e-9)])
 def test_runs_too_large_for_memory_are_refused_with_the_size(kw):
-    with pytest.raises(ValueError, match=r"1,000,000,001 samples x 29 signals, about 432.1 GiB .* more than the"):
+    n = JOINT_SIGNALS
+    gib = 2 * 8 * 1_000_000_001 * n / 2**30
+    with pytest.raises(ValueError, match=rf"1,000,000,001 samples x {n} signals, about {gib:,.1f} GiB .* more than the"):
         make_spec("paper2010", "cooperative", "0:-25", **kw)
 
 
@@ -62,7 +69,7 @@ def test_the_limit_is_half_the_memory_and_is_applied(monkeypatch):
     spec = make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0)
     args = engine_run.kernel_args(spec)
     samples, signals, need = engine_run.output_size(spec, args["run"])
-    assert (samples, signals) == (1001, 29) and need == 2 * 8 * 1001 * 29
+    assert (samples, signals) == (1001, JOINT_SIGNALS) and need == 2 * 8 * 1001 * JOINT_SIGNALS
     monkeypatch.setattr(engine_run, "memory_limit_bytes", lambda: need - 1)
     with pytest.raises(ValueError, match="GiB allowed"):
         make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0)

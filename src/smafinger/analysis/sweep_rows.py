@@ -156,10 +156,6 @@ def check_block(template: SweepTemplate, start: int, columns: dict[str, list]) -
             spec = template.build(values)
         except SPEC_ERRORS as exc:
             return CheckedBlock(start, ids[:k], n_seg, out_s, (start + k, values, str(exc)))
-        if spec.params.mechanism != "joint":  # the table's columns are the joint's (metrics_row)
-            msg = (f"params {spec.params.name!r} is a {spec.params.mechanism} set; sweeps tabulate the finger "
-                   "joint only (the angle, the upper and the lower wire)")
-            return CheckedBlock(start, ids[:k], n_seg, out_s, (start + k, values, msg))
         ids[k] = run_id(spec).encode()
         n_seg = max(n_seg, len(spec.profile.segments))
         out_s = max(out_s, spec.output_interval_s)
