@@ -67,3 +67,23 @@ def test_latent_heat_balance_through_a_transformation():
     # without the latent heat the same power heats the wire faster through the band
     plain = simulate(p.replace(latent_heat_J_kg=0.0), "open-loop", voltage=f"0:{V}:0", t_end_s=10.0, dt_s=1e-4)
     assert plain.T_upper_C[-1] > T[-1] + 5.0
+
+
+def test_radiative_loss_steady_state():
+    """With emissivity, Eq. (11)'s steady state solves P' = h A_w (T - T_amb) + eps sigma_SB A_w (T_K^4 - T_amb,K^4)."""
+    from scipy.optimize import brentq
+
+    h, eps, sigma_sb = 30.0, 0.8, 5.670374419e-8
+    p = get("paper2010").replace(h0_heating_W_m2K=h, h2_heating_W_m2K3=0.0, h0_cooling_W_m2K=h,
+                                 h2_cooling_W_m2K3=0.0, emissivity=eps)
+    _, _, A_w = wire_constants(p)
+    V = 4.0
+    P = V**2 / p.resistance_ohm_per_m
+    K = 273.15
+    loss = lambda T: h * A_w * (T - p.T_amb_C) + eps * sigma_sb * A_w * ((T + K) ** 4 - (p.T_amb_C + K) ** 4) - P
+    T_ss = brentq(loss, p.T_amb_C, p.T_amb_C + P / (h * A_w))
+    r = simulate(p, "open-loop", voltage=f"0:{V}:0", t_end_s=200.0, output_interval_s=0.1)
+    assert r.T_upper_C[-1] == pytest.approx(T_ss, rel=1e-6)
+    grey = simulate(p.replace(emissivity=0.0), "open-loop", voltage=f"0:{V}:0", t_end_s=200.0, output_interval_s=0.1)
+    assert grey.T_upper_C[-1] == pytest.approx(p.T_amb_C + P / (h * A_w), rel=1e-6)
+    assert grey.T_upper_C[-1] - r.T_upper_C[-1] > 1.0  # the radiation is not negligible at these temperatures

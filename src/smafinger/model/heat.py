@@ -20,6 +20,11 @@ from numba import njit
 
 from ..parameters.options import JouleHeating, ThermalModel
 
+#: Stefan-Boltzmann constant [W/(m^2 K^4)] (CODATA 2018, exact)
+STEFAN_BOLTZMANN_W_m2K4 = 5.670374419e-8
+#: 0 degC in kelvin
+KELVIN = 273.15
+
 
 @njit(cache=True, inline="always")
 def convection_coefficient(T, h0, h2):
@@ -69,9 +74,25 @@ def surroundings_C(wire, T_case, model):
 def wire_temperature_rate(wire, T, T_case, drive, heating, current_drive, opts):
     """Eq. (11) for a wire, with the heating or cooling coefficients of its phase (no latent heat)."""
     h = wire_h(wire, T, heating)
-    P = joule_power_per_m(wire, drive, current_drive, opts.joule_heating)
-    return heat_balance(T, P, h, surroundings_C(wire, T_case, opts.thermal_model), wire.mass_per_length_kg_m,
-                        wire.specific_heat_J_kgK, wire.perimeter_m)
+    T_sur = surroundings_C(wire, T_case, opts.thermal_model)
+    P = joule_power_per_m(wire, drive, current_drive, opts.joule_heating) - radiation_per_m(wire, T, T_sur)
+    return heat_balance(T, P, h, T_sur, wire.mass_per_length_kg_m, wire.specific_heat_J_kgK, wire.perimeter_m)
+
+
+@njit(cache=True, inline="always")
+def radiation_per_m(wire, T, T_sur):
+    """Radiative loss per metre [W/m] added to Eq. (11): eps sigma_SB A_w (T^4 - T_sur^4), kelvin inside.
+
+    Stefan-Boltzmann law for a grey wire in large surroundings at ``T_sur`` [degC]. The paper
+    lumps radiation into h (h2 T^2 stands for it); ``emissivity`` = 0 (every named set) leaves
+    Eq. (11) as published.
+    """
+    eps = wire.emissivity
+    if eps == 0.0:
+        return 0.0
+    Tk = T + KELVIN
+    Sk = T_sur + KELVIN
+    return eps * STEFAN_BOLTZMANN_W_m2K4 * wire.perimeter_m * (Tk ** 4 - Sk ** 4)
 
 
 @njit(cache=True, inline="always")

@@ -89,6 +89,9 @@ class ParameterSet:
     casing_loss_W_mK: float = _num(
         0.0, 1e4, "heat loss of the casing to the open air per kelvin, per metre of wire (two-node model)",
         wire=True, default=0.08)
+    emissivity: float = _num(
+        0.0, 1.0, "emissivity of the wire's surface for radiative loss (0: off, as in the paper; "
+        "polished NiTi: about 0.1-0.3)", wire=True, default=0.0)
 
     # --- drive and controller (Eq. 12, Sec. 2.6) -------------------------------------------
     V_H_V: float = _num(0.0, 100.0, "PWM high voltage V_H (the supply)")
