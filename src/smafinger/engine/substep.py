@@ -17,6 +17,7 @@ from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, i
 from ..model.records import Inputs, State, WireInput, WireState
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
 from .integrators import step
+from .pwm import PwmModel, averaged_drive, sampled_drive
 from .rhs import derivative, geometry_at
 from .tuples import filled, set_item, with_field
 
@@ -95,18 +96,59 @@ def _update_kinetics(model, y, inputs, k1, aux, stacks):
 
 
 @njit(cache=True, inline="always")
-def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, mid, stuck):
-    """(inputs, drives) for a sub-step whose midpoint is ``mid`` ticks into the PWM period."""
-    low = 0.0 if run.current_drive else model.drive.V_L_V
+def _drive(run, c, low, phase):
+    """A wire's drive under command ``c`` at ``phase`` ticks into the PWM period (:mod:`.pwm`).
+
+    ``exact``: the wave at ``phase`` (a sub-step's midpoint; sub-steps end at the edges);
+    ``averaged``: the period's RMS level; ``sampled``: the wave read at ``phase`` as the
+    authors' solver reads it.
+    """
+    if run.pwm == PwmModel.AVERAGED:
+        return averaged_drive(c.level, low, c.duty)
+    on = on_time(c.duty, run.pwm_ticks)
+    if run.pwm == PwmModel.SAMPLED:
+        return sampled_drive(c.level, low, c.duty, on, phase % run.pwm_ticks)
+    return pwm_output(c.level, low, c.duty, on, phase)
+
+
+@njit(cache=True, inline="always")
+def _low(model, run):
+    """The drive between PWM pulses: V_L, or 0 A with a current drive."""
+    return 0.0 if run.current_drive else model.drive.V_L_V
+
+
+@njit(cache=True, inline="always")
+def _with_drives(model, run, inputs, cmds, phase):
+    """``inputs`` with every wire's drive read at ``phase`` (the sampled PWM's later stages)."""
+    low = _low(model, run)
+    wis = inputs.wires
+    for i in range(len(wis)):
+        wi = wis[i]
+        wis = set_item(wis, i, WireInput(_drive(run, cmds[i], low, phase), wi.heating, wi.branch, wi.depth))
+    return with_field(inputs, "wires", wis)
+
+
+@njit(cache=True, inline="always")
+def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, phase, stuck):
+    """(inputs, drives, interlock drives) for a sub-step; ``phase``: where the drive is read.
+
+    The interlock drives are the resolved wave's: the sub-step's own with the exact PWM, the
+    levels at the period start (where every wire with a duty above 0 is on) otherwise.
+    """
+    low = _low(model, run)
     w = model.wires
     drives = filled(w, 0.0)
+    resolved = filled(w, 0.0)
     wis = inputs.wires
     for i in range(len(w)):
         c = cmds[i]
-        d = pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), mid)
+        d = _drive(run, c, low, phase)
         drives = set_item(drives, i, d)
-        wis = set_item(wis, i, WireInput(d, c.heating, wis[i].branch, wis[i].depth))
-    return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, low
+        if run.pwm != PwmModel.EXACT:
+            d = pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), 0.0)
+        resolved = set_item(resolved, i, d)
+        wis = set_item(wis, i, WireInput(drives[i], c.heating, wis[i].branch, wis[i].depth))
+    return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, resolved, low
 
 
 @njit(cache=True, inline="always")
@@ -141,9 +183,10 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
     """
     geom = geometry_at(y.q, geom_q, geom, model)
     geom_q = y.q
-    inputs, drives, low = _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating,
-                                       0.5 * (a + b) - ps, stuck)
-    if opposing_wires_driven(model.wires, drives, low) and b > a:
+    phase = a - ps if run.pwm == PwmModel.SAMPLED else 0.5 * (a + b) - ps
+    inputs, drives, resolved, low = _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating,
+                                                 phase, stuck)
+    if opposing_wires_driven(model.wires, resolved, low) and b > a:
         counters = with_field(counters, "violations", counters.violations + 1)
     # the derivative at the sub-step start; then the kinetics branches and Eq. (2) are decided from
     # it, and whenever a decision changes what the derivative depends on it is evaluated again
@@ -175,13 +218,20 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, inline="always")
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters):
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, ps):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 
-    Returns (y, counters, t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
+    With the sampled PWM the later stages read the drive at their own times (``ps``: the
+    PWM period start of the step). Returns (y, counters, t_fail_s); ``counters.status`` is 1
+    if the state is no longer finite.
     """
     if b > a:
-        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom)
+        inputs_mid = inputs
+        inputs_end = inputs
+        if run.pwm == PwmModel.SAMPLED:
+            inputs_mid = _with_drives(model, run, inputs, cmds, 0.5 * (a + b) - ps)
+            inputs_end = _with_drives(model, run, inputs, cmds, b - ps)
+        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, inputs_mid, inputs_end)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
