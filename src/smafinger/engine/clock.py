@@ -12,6 +12,8 @@ import numpy as np
 
 #: one tick [s]
 TICK_S = 1e-9
+#: ticks per second (exact: ticks / TICKS_PER_S is the correctly rounded time in seconds)
+TICKS_PER_S = 1_000_000_000
 
 
 def to_ticks(name: str, value_s: float, allow_zero: bool = False) -> int:

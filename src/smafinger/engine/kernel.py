@@ -24,7 +24,7 @@ from ..control.strategies import Strategy
 from ..model.hysteresis_memory import STACK_COLUMNS
 from ..parameters.options import IntegralReset
 from .dense import interpolated, zero_aux
-from .pwm import PwmModel
+from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, track_reach
 from .signals import record_sample
@@ -162,6 +162,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     n_out = mech_out.shape[0]
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1)
     integrating = 1.0
+    pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
     next_event = _next_event(s, run, segs, prog, prog_i)
@@ -189,8 +190,11 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         a = float(t)
         for j in range(_sub_bounds(t, t_next, ps, cmds, run, bounds)):
             b = bounds[j]
+            phase, phase_mid, phase_end = 0.5 * (a + b) - ps, 0.0, 0.0
+            if run.pwm == PwmModel.SAMPLED:
+                phase, phase_mid, phase_end, pwm_ref = sampled_phases(a, b, run.dt_ticks, run.pwm_ticks, pwm_ref)
             y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives = decide(
-                model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck,
+                model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck,
                 v_prev, counters, stacks)
             first = False
             now = (int(a), y, aux, cmds, drives, stuck, s.q_target, s.next_seg - 1)
@@ -198,7 +202,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             if out_i < n_out and (next_out < a or (final and next_out == a)):
                 out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, a, final, prev, now)
             prev = now
-            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, ps)
+            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, phase_mid,
+                                            phase_end)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b

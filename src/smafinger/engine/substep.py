@@ -16,6 +16,7 @@ from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.records import Inputs, State, WireInput, WireState
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
+from .clock import TICKS_PER_S
 from .integrators import step
 from .pwm import PwmModel, averaged_drive, sampled_drive
 from .rhs import derivative, geometry_at
@@ -99,16 +100,15 @@ def _update_kinetics(model, y, inputs, k1, aux, stacks):
 def _drive(run, c, low, phase):
     """A wire's drive under command ``c`` at ``phase`` ticks into the PWM period (:mod:`.pwm`).
 
-    ``exact``: the wave at ``phase`` (a sub-step's midpoint; sub-steps end at the edges);
-    ``averaged``: the period's RMS level; ``sampled``: the wave read at ``phase`` as the
-    authors' solver reads it.
+    ``exact``: the wave at ``phase`` ticks (a sub-step's midpoint; sub-steps end at the edges);
+    ``averaged``: the period's RMS level; ``sampled``: the wave read ``phase`` seconds after the
+    period's reference time, as the authors' solver reads it (:func:`.pwm.sampled_phases`).
     """
     if run.pwm == PwmModel.AVERAGED:
         return averaged_drive(c.level, low, c.duty)
-    on = on_time(c.duty, run.pwm_ticks)
     if run.pwm == PwmModel.SAMPLED:
-        return sampled_drive(c.level, low, c.duty, on, phase % run.pwm_ticks)
-    return pwm_output(c.level, low, c.duty, on, phase)
+        return sampled_drive(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks / TICKS_PER_S), phase)
+    return pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), phase)
 
 
 @njit(cache=True, inline="always")
@@ -174,16 +174,16 @@ def _finite(y):
 
 
 @njit(cache=True, inline="always")
-def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck, v_prev,
+def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck, v_prev,
            counters, stacks):
     """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, kinetics
-    branches (Eqs. 9-10), stick/slip (Eq. 2), and the derivative there.
+    branches (Eqs. 9-10), stick/slip (Eq. 2), and the derivative there. ``phase``: where the
+    PWM is read (:func:`_drive`).
 
     Returns (y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives).
     """
     geom = geometry_at(y.q, geom_q, geom, model)
     geom_q = y.q
-    phase = a - ps if run.pwm == PwmModel.SAMPLED else 0.5 * (a + b) - ps
     inputs, drives, resolved, low = _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating,
                                                  phase, stuck)
     if opposing_wires_driven(model.wires, resolved, low) and b > a:
@@ -218,19 +218,19 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, inline="always")
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, ps):
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, phase_mid, phase_end):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 
-    With the sampled PWM the later stages read the drive at their own times (``ps``: the
-    PWM period start of the step). Returns (y, counters, t_fail_s); ``counters.status`` is 1
-    if the state is no longer finite.
+    With the sampled PWM the later stages read the drive at their own phases (``phase_mid``,
+    ``phase_end``). Returns (y, counters, t_fail_s); ``counters.status`` is 1 if the state is
+    no longer finite.
     """
     if b > a:
         inputs_mid = inputs
         inputs_end = inputs
         if run.pwm == PwmModel.SAMPLED:
-            inputs_mid = _with_drives(model, run, inputs, cmds, 0.5 * (a + b) - ps)
-            inputs_end = _with_drives(model, run, inputs, cmds, b - ps)
+            inputs_mid = _with_drives(model, run, inputs, cmds, phase_mid)
+            inputs_end = _with_drives(model, run, inputs, cmds, phase_end)
         y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, inputs_mid, inputs_end)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
