@@ -26,7 +26,7 @@ from ..parameters.options import IntegralReset
 from .dense import interpolated, zero_aux
 from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
-from .schedule import Schedule, advance, track_reach
+from .schedule import Schedule, advance, confirm_tick, track_reach
 from .signals import record_sample
 from .substep import STACK_CAPACITY, Counters, decide, initial_commands, initial_inputs, initial_state, integrate
 from .tuples import filled, with_field
@@ -163,6 +163,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1)
     integrating = 1.0
     pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)
+    locate = run.pwm == PwmModel.AVERAGED  #: long steps: reach events located inside a step
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
     next_event = _next_event(s, run, segs, prog, prog_i)
@@ -185,7 +186,13 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
             cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
-        t_next = _interval_end(t, run, cmds, next_event)
+        event = next_event
+        if locate:  # long steps: one ends where the target will count as reached
+            c = confirm_tick(s, run.hold_ticks)
+            if c > t and (event <= t or c < event):
+                event = c
+        t_next = _interval_end(t, run, cmds, event)
+        t_start, q_start = t, y.q
         ps = (t // run.pwm_ticks) * run.pwm_ticks
         a = float(t)
         for j in range(_sub_bounds(t, t_next, ps, cmds, run, bounds)):
@@ -210,7 +217,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         if t >= run.t_end_ticks:
             break
         t = t_next
-        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks)
+        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks, t_start, q_start, locate)
         if reached >= 0:
             seg_reached[s.next_seg - 1] = reached
         if t >= run.t_end_ticks and out_i >= n_out:
