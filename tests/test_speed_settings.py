@@ -166,3 +166,36 @@ def test_pwm_model_reaches_the_kernel():
     spec = make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0, method="authors-ode4")
     assert kernel_args(spec)["run"].pwm == PwmModel.SAMPLED
     assert math.isclose(spec.dt_s, 1e-3)
+
+
+def _stage_drives(run, q_target_deg):
+    """Each wire's (drive, heating) that a later stage of authors-ode4 sees at the initial state."""
+    from smafinger.engine.authors import Stages, stage_inputs
+    from smafinger.engine.substep import initial_commands, initial_inputs, initial_state
+
+    model = kernel_args(make_spec("authors2020", "independent", "0:-25:upper", t_end_s=1.0,
+                                  method="authors-ode4"))["model"]
+    y = initial_state(model)
+    held = initial_commands(model)  # the tick's commands: every wire off
+    st = Stages(run, held, 0b11, math.radians(q_target_deg), 0.0, 0.0, 0.0)
+    inputs = stage_inputs(model, initial_inputs(model, False), y, st, 0.0)
+    return [(w.drive, w.heating) for w in inputs.wires], model.drive.V_H_V
+
+
+def test_authors_stages_re_evaluate_the_controller():
+    """Their controller (dtCtrl = 0) runs at every stage: from -40 deg towards -25 deg the upper
+    wire heats at V_H though the tick's commands held every wire off; towards -55 deg the lower."""
+    run = kernel_args(make_spec("authors2020", "independent", "0:-25:upper", t_end_s=1.0,
+                                method="authors-ode4"))["run"]
+    assert run.update_ticks == 0
+    up, v_h = _stage_drives(run, -25.0)
+    down, _ = _stage_drives(run, -55.0)
+    assert sorted(d for d, _ in up) == [0.0, v_h] and sum(h for _, h in up) == 1
+    assert [d for d, _ in up] == [d for d, _ in reversed(down)]
+
+
+def test_authors_stages_keep_the_ticks_commands_with_a_controller_period():
+    run = kernel_args(make_spec("authors2020", "independent", "0:-25:upper", t_end_s=1.0,
+                                method="authors-ode4"))["run"]
+    held, _ = _stage_drives(run._replace(update_ticks=run.dt_ticks), -25.0)
+    assert [d for d, _ in held] == [0.0, 0.0]

@@ -27,6 +27,7 @@ import math
 from numba import njit
 
 from ..model.records import State, WireState
+from .authors import stage_inputs
 from .rhs import derivative, geometry_at
 from .tuples import set_item
 
@@ -110,13 +111,14 @@ def _damped_mechanism(method, y, k1, h, c):
 
 
 @njit(cache=True, inline="always")
-def step(method, model, y, h, inputs, k1, geom, inputs_mid, inputs_end):
+def step(method, model, y, h, inputs, k1, geom, stages):
     """y advanced by h (see the module docstring for the methods). Returns (y, evaluations).
 
     RK4 as a loop over its three later stages (one right-hand-side call site, so that it is
-    compiled once): the weighted sum accumulates k1 + 2 k2 + 2 k3 + k4 in that order. The
-    stages at h/2 see ``inputs_mid`` and the last one ``inputs_end`` (the same as ``inputs``
-    except with the authors' sampled PWM).
+    compiled once): the weighted sum accumulates k1 + 2 k2 + 2 k3 + k4 in that order.
+    ``authors-ode4``: each later stage's inputs come from the controller at that stage's state
+    and the PWM read at its phase (:func:`.authors.stage_inputs`); ``stages``
+    (:class:`.authors.Stages`) is what they need.
     """
     if method == Method.EULER:
         return axpy(y, h, k1), 0
@@ -133,6 +135,9 @@ def step(method, model, y, h, inputs, k1, geom, inputs_mid, inputs_end):
         yk = axpy(y, h if stage == 2 else half, k)
         g = geometry_at(yk.q, q_prev, g, model)
         q_prev = yk.q
-        k = derivative(yk, inputs_end if stage == 2 else inputs_mid, model, g)[0]
+        inp = inputs
+        if method == Method.AUTHORS_ODE4:
+            inp = stage_inputs(model, inputs, yk, stages, stages.phase_end if stage == 2 else stages.phase_mid)
+        k = derivative(yk, inp, model, g)[0]
         acc = axpy(acc, 1.0 if stage == 2 else 2.0, k)
     return axpy(y, h / 6.0, acc), 3

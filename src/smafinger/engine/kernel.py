@@ -209,8 +209,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             if out_i < n_out and (next_out < a or (final and next_out == a)):
                 out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, a, final, prev, now)
             prev = now
-            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, phase_mid,
-                                            phase_end)
+            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
+                                            phase_mid, phase_end)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b

@@ -16,6 +16,7 @@ from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.records import Inputs, State, WireInput, WireState
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
+from .authors import Stages
 from .clock import TICKS_PER_S
 from .integrators import step
 from .pwm import PwmModel, averaged_drive, sampled_drive
@@ -118,17 +119,6 @@ def _low(model, run):
 
 
 @njit(cache=True, inline="always")
-def _with_drives(model, run, inputs, cmds, phase):
-    """``inputs`` with every wire's drive read at ``phase`` (the sampled PWM's later stages)."""
-    low = _low(model, run)
-    wis = inputs.wires
-    for i in range(len(wis)):
-        wi = wis[i]
-        wis = set_item(wis, i, WireInput(_drive(run, cmds[i], low, phase), wi.heating, wi.branch, wi.depth))
-    return with_field(inputs, "wires", wis)
-
-
-@njit(cache=True, inline="always")
 def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, phase, stuck):
     """(inputs, drives, interlock drives) for a sub-step; ``phase``: where the drive is read.
 
@@ -218,20 +208,17 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, inline="always")
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, phase_mid, phase_end):
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 
-    With the sampled PWM the later stages read the drive at their own phases (``phase_mid``,
-    ``phase_end``). Returns (y, counters, t_fail_s); ``counters.status`` is 1 if the state is
-    no longer finite.
+    With the authors' solver the later stages read the controller and the PWM at their own
+    states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
+    schedule; see :func:`.authors.stage_inputs`). Returns (y, counters,
+    t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
     """
     if b > a:
-        inputs_mid = inputs
-        inputs_end = inputs
-        if run.pwm == PwmModel.SAMPLED:
-            inputs_mid = _with_drives(model, run, inputs, cmds, phase_mid)
-            inputs_end = _with_drives(model, run, inputs, cmds, phase_end)
-        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, inputs_mid, inputs_end)
+        stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end)
+        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
