@@ -11,7 +11,8 @@ setting alike) and printed as ratios:
 
 Cases: the paper's co-operative full cycle (Fig. 15, -40 -> -25 -> -55 -> -40 deg, 45 s,
 ``paper2010``); the linear bias-spring rig's closed-loop cycle (10 mm, then 4 mm, 30 s);
-the authors' 2020 profile 2 (``authors2020``, independent, 20 s).
+the authors' 2020 profile 2 (``authors2020``, independent, 20 s). Then the authors' solver
+(``authors-ode4``): the peak wire temperatures of their profiles 1 and 2 against their plots.
 
 Then the legacy engine (commit ff21ad0, before the engine redesign) as recorded on this kind
 of machine, the SciPy baseline (the test oracle's ``solve_ivp``, open loop: it has no
@@ -143,6 +144,27 @@ def bench_scipy(repeat: int) -> None:
               f"{info['wall_s'] / best:6.0f}x; max |dtheta| vs LSODA {err:.4f} deg")
 
 
+#: the authors' 2020 profiles (paper/authors.py) and the published peak wire temperatures [degC]
+#: read off their plots (gabrielegilardi/FingerControl, Example<n>_Results_SMA<k>); None: not known
+AUTHORS_PROFILES = (
+    (1, "0:-25:upper,5:-40:none,10:-30:upper", {"upper": None, "lower": None}),
+    (2, "0:-25:upper,5:-55:both", {"upper": None, "lower": 135.0}),
+)
+
+
+def bench_authors() -> None:
+    """Issue 10 section 4: peak wire temperatures, resolved PWM against the authors' solver."""
+    print("\n== authors2020 peak wire temperatures (20 s): resolved PWM (rk4 1 ms exact) vs authors-ode4")
+    for number, profile, published in AUTHORS_PROFILES:
+        for method in ("rk4", "authors-ode4"):
+            r = run_spec(make_spec("authors2020", "independent", profile, t_end_s=20.0, method=method))
+            peaks = {w: float(np.max(r.signal(f"T_{w}_C"))) for w in published}
+            shown = ", ".join(f"{w} {t:6.1f} degC" + ("" if published[w] is None else
+                                                       f" (published {published[w]:g}, diff {t - published[w]:+.1f})")
+                              for w, t in peaks.items())
+            print(f"   profile {number} {method:13s}: {shown}")
+
+
 def _process_s(code: str, env: dict | None = None, repeat: int = 3) -> float:
     best = float("inf")
     for _ in range(repeat):
@@ -179,6 +201,7 @@ def main() -> None:
     results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
     bench_legacy(results[CASES[0][0]])
     bench_scipy(args.repeat)
+    bench_authors()
     bench_process(args.cold)
 
 

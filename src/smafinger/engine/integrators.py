@@ -13,8 +13,10 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
   load with the damping C_DF (phi functions), the wires by Euler. Like ``semi-implicit`` but
   exact for the damped motion under a constant load.
 - ``authors-ode4``: the authors' Simulink solver (classical RK4 at a fixed step, MODEL-NOTES)
-  with the PWM read at the stage times (:mod:`.pwm`, ``sampled``), so that the ``authors2020``
-  set reproduces their published curves, temperatures included.
+  with the PWM read at the stage times (:mod:`.pwm`, ``sampled``) and the controller
+  re-evaluated at every stage (:mod:`.authors`), as their model does. Not yet enough to
+  reproduce their published temperatures: profile 2's lower-wire peak is 155.7 degC with it,
+  123.6 degC with the resolved PWM, 135 degC in their plots (docs/speed.md).
 """
 
 from __future__ import annotations
