@@ -34,7 +34,7 @@ def final_state(p, method, dt):
                      math.radians(r.omega_deg_s[-1])])
 
 
-@pytest.mark.parametrize("name", ["euler", "rk4"])
+@pytest.mark.parametrize("name", ["euler", "rk4", "semi-implicit", "exponential", "authors-ode4"])
 def test_convergence_order(name):
     p = smooth_case()
     integ = integrators.get(name)

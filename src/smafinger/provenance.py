@@ -6,7 +6,7 @@ metadata, a MATLAB file's ``provenance`` struct, each row's run of a sweep table
 - ``smafinger_version``;
 - ``run``: the run definition (:func:`run_definition`): the mechanism, every parameter and
   model option after overrides, the strategy, the target profile, the drive program (its
-  kind and steps), ``t_end_s``, ``dt_s``, ``method``, ``output_interval_s``, the tolerances,
+  kind and steps), ``t_end_s``, ``dt_s``, ``method``, ``pwm``, ``output_interval_s``, the tolerances,
   ``hold_s`` and ``independent_wait``. Numbers are written exactly (shortest round-trip
   form), never rounded;
 - ``run_sha256``: the SHA-256 of the definition's canonical JSON (keys sorted, no spaces).
@@ -24,7 +24,7 @@ from typing import Any
 #: bump when the meaning of a run definition changes
 SCHEMA = 1
 #: run definition keys, besides ``schema``, ``mechanism`` and ``parameters``
-RUN_KEYS = ("strategy", "profile", "drive", "t_end_s", "dt_s", "method", "output_interval_s", "tol_deg",
+RUN_KEYS = ("strategy", "profile", "drive", "t_end_s", "dt_s", "method", "pwm", "output_interval_s", "tol_deg",
             "tol_m", "hold_s", "independent_wait")
 
 
@@ -47,7 +47,7 @@ def run_definition(spec) -> dict[str, Any]:
         "strategy": spec.strategy,
         "profile": spec.profile.to_text(),
         "drive": None if v is None else {"kind": v.kind, "program": program_text(v)},
-        "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method,
+        "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method, "pwm": spec.pwm,
         "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg, "tol_m": spec.tol_m,
         "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
     }

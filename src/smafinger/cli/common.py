@@ -10,6 +10,7 @@ import typer
 
 from ..control.strategies import STRATEGIES
 from ..engine.integrators import INTEGRATORS
+from ..engine.pwm import PWM_MODELS
 from ..progress import Display
 from .errors import UsageError, reading_input
 
@@ -17,6 +18,7 @@ from .errors import UsageError, reading_input
 Strategy = Literal[tuple(STRATEGIES)]
 #: ``--method`` values
 Method = Literal[tuple(INTEGRATORS)]
+Pwm = Literal[tuple(PWM_MODELS)]
 
 
 def given(ctx: typer.Context, *names: str) -> list[str]:

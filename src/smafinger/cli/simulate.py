@@ -7,13 +7,13 @@ from typing import List, Optional
 
 import typer
 
-from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_TOL_M
-from .common import Method, Strategy, given, load_params, progress_display, progress_option, refuse
+from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M
+from .common import Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
 #: options that define the run (refused with --from; --scenario takes some of them)
 RUN_OPTIONS = ("params", "set_", "scenario", "strategy", "profile", "voltage", "duty", "current", "t_end", "dt",
-               "method", "output_interval", "tol_deg", "tol_m", "hold_s")
+               "method", "pwm", "output_interval", "tol_deg", "tol_m", "hold_s")
 #: options a scenario defines and the command line cannot change
 NOT_WITH_SCENARIO = ("params", "voltage", "duty", "current", "tol_m")
 
@@ -41,7 +41,10 @@ def simulate(
     current: Optional[str] = typer.Option(None, "--current", metavar="T:I_1[:I_2],...", help="open-loop program [A]"),
     t_end: float = typer.Option(20.0, "--t-end", metavar="S", help="simulated time [s]"),
     dt: float = typer.Option(DEFAULT_DT_S, "--dt", metavar="S", help="integration step [s]"),
-    method: Method = typer.Option(DEFAULT_METHOD, "--method", help="integrator"),
+    method: Method = typer.Option(DEFAULT_METHOD, "--method", help="integrator (authors-ode4: the authors' Simulink "
+                                                                    "solver, fixed 1 ms, PWM read at its stages)"),
+    pwm: Pwm = typer.Option(DEFAULT_PWM, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
+                                                       "averaged power (averaged: long steps; docs/speed.md)"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
     tol_deg: float = typer.Option(0.5, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
     tol_m: float = typer.Option(DEFAULT_TOL_M, "--tol-m", metavar="M", help="target tolerance of a linear actuator [m]"),
@@ -60,7 +63,7 @@ def simulate(
 
     _check_outputs(out, summary, plot)
     spec, extra = _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt,
-                        method, output_interval, tol_deg, tol_m, hold_s)
+                        method, pwm, output_interval, tol_deg, tol_m, hold_s)
     with progress_display(progress) as display:
         try:
             result = run_spec(spec, progress=display)
@@ -94,7 +97,7 @@ def _check_outputs(out: Path | None, summary: Path | None, plot: Path | None) ->
     check_outputs(targets)
 
 
-def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt, method,
+def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt, method, pwm,
           output_interval, tol_deg, tol_m, hold_s):
     """(the run spec, what the outputs record beside it) from the options."""
     from ..engine.run import make_spec
@@ -121,7 +124,7 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
 
         with reading_input():
             spec = scenarios.get(scenario).spec(
-                overrides=set_ or [], dt_s=dt, method=method, output_interval_s=output_interval,
+                overrides=set_ or [], dt_s=dt, method=method, pwm=pwm, output_interval_s=output_interval,
                 tol_deg=option(tol_deg, "--tol-deg"), hold_s=option(hold_s, "--hold-s"),
                 strategy=option(strategy, "--strategy"), profile=option(profile, "--profile"),
                 t_end_s=option(t_end, "--t-end"))
@@ -130,4 +133,4 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
     p = load_params(params, set_)
     with reading_input():
         return make_spec(p, strategy, profile, program, t_end, dt, method, output_interval, tol_deg, hold_s,
-                         tol_m=tol_m, drive=kind), {}
+                         tol_m=tol_m, drive=kind, pwm=pwm), {}

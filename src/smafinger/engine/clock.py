@@ -21,6 +21,8 @@ MAX_S = MAX_TICKS * TICK_S
 
 def _beyond(name: str, value_s) -> ValueError:
     return ValueError(f"{name} = {value_s!r} s is beyond the clock's range ({MAX_S:.3g} s, about 146 years)")
+#: ticks per second (exact: ticks / TICKS_PER_S is the correctly rounded time in seconds)
+TICKS_PER_S = 1_000_000_000
 
 
 def to_ticks(name: str, value_s: float, allow_zero: bool = False) -> int:

@@ -4,7 +4,9 @@ Time runs on an integer clock of ``tick_s`` seconds (1 ns): step ends, PWM perio
 controller updates, output samples and target changes fall on exact integer ticks, so no time
 drifts from adding dt. Within a step, the PWM duty edges (period start + t_DC, Eq. 12b) split
 the step, so that each sub-step sees a constant drive: the edges are resolved exactly whatever
-the step size.
+the step size. With a PWM model other than ``exact`` (:mod:`.pwm`) the drive is constant over
+a step without splitting it, and steps do not end at output samples either: the samples between
+two sub-step starts are interpolated (:mod:`.dense`).
 
 At every sub-step start the discrete state is updated (:mod:`.substep`): drives, kinetics
 branches, stick/slip; the interlock is checked (two opposing wires driven at once counts as a
@@ -21,11 +23,13 @@ from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
 from ..model.hysteresis_memory import STACK_COLUMNS
 from ..parameters.options import IntegralReset
+from .dense import interpolated, zero_aux
+from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
-from .schedule import Schedule, advance, track_reach
+from .schedule import Schedule, advance, confirm_tick, track_reach
 from .signals import record_sample
 from .substep import STACK_CAPACITY, Counters, decide, initial_commands, initial_inputs, initial_state, integrate
-from .tuples import with_field
+from .tuples import filled, with_field
 
 
 class RunSettings(NamedTuple):
@@ -43,6 +47,7 @@ class RunSettings(NamedTuple):
     pwm_ticks: int
     tol: float  #: a target is reached within this (rad or m)...
     hold_ticks: int  #: ...for this long
+    pwm: int = PwmModel.EXACT  #: pwm.PwmModel: how the drive is applied
 
 
 class Program(NamedTuple):
@@ -58,10 +63,11 @@ def _interval_end(t, run, cmds, next_event):
     """End of the interval that starts at tick t: the next step, PWM period, sample, update or event."""
     ps = (t // run.pwm_ticks) * run.pwm_ticks
     t_next = min(((t // run.dt_ticks) + 1) * run.dt_ticks, run.t_end_ticks)
-    for c in cmds:
-        if 0.0 < c.duty < 100.0:  # a duty strictly inside (0, 100) %: split at every period start
-            t_next = min(t_next, ps + run.pwm_ticks)
-    t_next = min(t_next, ((t // run.out_ticks) + 1) * run.out_ticks)
+    if run.pwm == PwmModel.EXACT:
+        for c in cmds:
+            if 0.0 < c.duty < 100.0:  # a duty strictly inside (0, 100) %: split at every period start
+                t_next = min(t_next, ps + run.pwm_ticks)
+        t_next = min(t_next, ((t // run.out_ticks) + 1) * run.out_ticks)  # else: samples interpolated
     if run.update_ticks > 0:
         t_next = min(t_next, ((t // run.update_ticks) + 1) * run.update_ticks)
     if next_event > t:
@@ -70,11 +76,13 @@ def _interval_end(t, run, cmds, next_event):
 
 
 @njit(cache=True, inline="always")
-def _sub_bounds(t, t_next, ps, cmds, pwm_ticks, bounds):
-    """Fill ``bounds`` with the sub-step ends in (t, t_next]: the PWM duty edges, then t_next."""
+def _sub_bounds(t, t_next, ps, cmds, run, bounds):
+    """Fill ``bounds`` with the sub-step ends in (t, t_next]: the PWM duty edges (exact PWM), then t_next."""
     nb = 0
     for c in cmds:
-        e = pwm_edge(ps, c.duty, pwm_ticks)
+        if run.pwm != PwmModel.EXACT:
+            break
+        e = pwm_edge(ps, c.duty, run.pwm_ticks)
         if not (e > t and e < t_next):
             continue
         k = nb  # insertion sort, duplicates dropped
@@ -88,6 +96,27 @@ def _sub_bounds(t, t_next, ps, cmds, pwm_ticks, bounds):
         nb += 1
     bounds[nb] = t_next
     return nb + 1
+
+
+@njit(cache=True, inline="always")
+def _flush(mo, wo, out_i, next_out, run, a, final, prev, now):
+    """Write the output samples due before sub-step start ``a`` (and at ``a`` on the final pass).
+
+    ``prev`` and ``now`` are (tick, state, aux, cmds, drives, stuck, q_target, segment) at the
+    previous sub-step start and at ``a``. A sample at ``prev``'s tick takes its values, one in
+    between interpolates them (:func:`.dense.interpolated`); one at ``a`` takes ``now``'s. With
+    the exact PWM every sample falls on a sub-step start. Returns (out_i, next_out).
+    """
+    n_out = mo.shape[0]
+    while out_i < n_out and (next_out < a or (final and next_out == a)):
+        src = now if next_out == a else prev
+        y, aux = src[1], src[2]
+        if next_out != a and next_out != prev[0]:
+            y, aux = interpolated(prev[1], prev[2], now[1], now[2], (next_out - prev[0]) / (a - prev[0]))
+        record_sample(mo, wo, out_i, float(next_out) * run.tick_s, y, aux, src[6], src[7], src[5], src[3], src[4])
+        out_i += 1
+        next_out += run.out_ticks
+    return out_i, next_out
 
 
 @njit(cache=True, inline="always")
@@ -131,7 +160,10 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     bounds = np.empty(len(model.wires) + 1)
     stacks = np.zeros((len(model.wires), STACK_CAPACITY, STACK_COLUMNS))  # reversal points, per wire
     n_out = mech_out.shape[0]
+    prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1)
     integrating = 1.0
+    pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)
+    locate = run.pwm == PwmModel.AVERAGED  #: long steps: reach events located inside a step
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
     next_event = _next_event(s, run, segs, prog, prog_i)
@@ -154,30 +186,40 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
             cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
-        t_next = _interval_end(t, run, cmds, next_event)
+        event = next_event
+        if locate:  # long steps: one ends where the target will count as reached
+            c = confirm_tick(s, run.hold_ticks)
+            if c > t and (event <= t or c < event):
+                event = c
+        t_next = _interval_end(t, run, cmds, event)
+        t_start, q_start = t, y.q
         ps = (t // run.pwm_ticks) * run.pwm_ticks
         a = float(t)
-        for j in range(_sub_bounds(t, t_next, ps, cmds, run.pwm_ticks, bounds)):
+        for j in range(_sub_bounds(t, t_next, ps, cmds, run, bounds)):
             b = bounds[j]
+            phase, phase_mid, phase_end = 0.5 * (a + b) - ps, 0.0, 0.0
+            if run.pwm == PwmModel.SAMPLED:
+                phase, phase_mid, phase_end, pwm_ref = sampled_phases(a, b, run.dt_ticks, run.pwm_ticks, pwm_ref)
             y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives = decide(
-                model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck,
+                model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck,
                 v_prev, counters, stacks)
             first = False
-            if j == 0 and t == next_out and out_i < n_out:
-                record_sample(mech_out, wire_out, out_i, a * run.tick_s, y, aux, s.q_target, s.next_seg - 1,
-                              stuck, cmds, drives)
-                out_i += 1
-                next_out += run.out_ticks
-            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters)
+            now = (int(a), y, aux, cmds, drives, stuck, s.q_target, s.next_seg - 1)
+            final = t >= run.t_end_ticks
+            if out_i < n_out and (next_out < a or (final and next_out == a)):
+                out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, a, final, prev, now)
+            prev = now
+            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
+                                            phase_mid, phase_end)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b
         if t >= run.t_end_ticks:
             break
         t = t_next
-        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks)
+        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks, t_start, q_start, locate)
         if reached >= 0:
             seg_reached[s.next_seg - 1] = reached
-        if t >= run.t_end_ticks and not (t == next_out and out_i < n_out):
-            break  # else: one more pass records the final sample
+        if t >= run.t_end_ticks and out_i >= n_out:
+            break  # else: one more pass records the samples still due
     return counters, y, 0.0

@@ -18,7 +18,7 @@ from ..parameters import ParameterSet, resolve
 from ..progress import Display
 from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
-from . import integrators
+from . import integrators, pwm as pwm_models
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
@@ -30,6 +30,8 @@ DEFAULT_DT_S = 1e-3
 #: the open-loop Table II runs of Figs. 7-8 (a stiff joint-tendon mode): not a safe default.
 DEFAULT_METHOD = "rk4"
 DEFAULT_OUTPUT_S = 1e-3
+#: the PWM resolved at its edges (engine.pwm); "averaged" allows long steps (docs/speed.md)
+DEFAULT_PWM = "exact"
 #: default target tolerance of the linear actuator [m]
 DEFAULT_TOL_M = 5e-4
 
@@ -54,6 +56,7 @@ class RunSpec:
     hold_s: float
     independent_wait: bool
     tol_m: float = DEFAULT_TOL_M  #: target tolerance of the linear actuator [m]
+    pwm: str = DEFAULT_PWM  #: how the PWM drive is applied (engine.pwm): exact or averaged
 
     @property
     def tolerance(self) -> float:
@@ -63,7 +66,8 @@ class RunSpec:
 
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
               t_end_s=20.0, dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S,
-              tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage") -> RunSpec:
+              tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage",
+              pwm=DEFAULT_PWM) -> RunSpec:
     """A validated :class:`RunSpec` (see :func:`simulate` for the arguments).
 
     Raises ``TypeError`` for an argument of the wrong type and ``ValueError`` (or its
@@ -72,11 +76,13 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     """
     _check_types(params=params, strategy=strategy, profile=profile, voltage=voltage, t_end_s=t_end_s,
                  dt_s=dt_s, method=method, output_interval_s=output_interval_s, tol_deg=tol_deg,
-                 hold_s=hold_s, independent_wait=independent_wait, tol_m=tol_m, drive=drive)
+                 hold_s=hold_s, independent_wait=independent_wait, tol_m=tol_m, drive=drive, pwm=pwm)
     p = resolve(params)
     if strategy not in STRATEGIES:
         raise ValueError(f"strategy = {strategy!r} is not one of {', '.join(STRATEGIES)}")
-    integrators.get(method)
+    pwm_model = pwm_models.get(pwm)
+    if integrators.get(method).pwm_sampled and pwm_model != pwm_models.PwmModel.EXACT:
+        raise ValueError(f"pwm = {pwm!r} does not apply to method = {method!r}, which reads the PWM at its stages")
     if isinstance(profile, str):
         profile = TargetProfile.parse(profile)
     if isinstance(voltage, str):
@@ -96,7 +102,8 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
     spec = RunSpec(p, strategy, profile, voltage, float(t_end_s), float(dt_s), method,
-                   float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m))
+                   float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m),
+                   pwm)
     kernel_args(spec)  # validates the times, targets and program against the mechanism
     return spec
 
@@ -110,6 +117,7 @@ _ARG_TYPES = {
     "voltage": ((str, VoltageProgram, type(None)), 'a program text such as "0:8:0,6:0:0" or a VoltageProgram'),
     "method": ((str,), f"one of {', '.join(integrators.INTEGRATORS)}"),
     "drive": ((str,), f"one of {', '.join(DRIVE_KINDS)}"),
+    "pwm": ((str,), f"one of {', '.join(pwm_models.PWM_MODELS)}"),
     "independent_wait": ((bool, np.bool_), "True or False"),
 }
 
@@ -206,15 +214,17 @@ def kernel_args(spec: RunSpec) -> dict:
     if dt > t_end:
         raise ValueError(f"dt_s = {spec.dt_s} is longer than t_end_s = {spec.t_end_s}")
     p = spec.params
+    integ = integrators.get(spec.method)
     run = RunSettings(
-        strategy=STRATEGIES[spec.strategy], method=integrators.get(spec.method).code,
+        strategy=STRATEGIES[spec.strategy], method=integ.code,
         wait_release=spec.independent_wait,
         current_drive=spec.voltage is not None and spec.voltage.kind == "current",
         tick_s=TICK_S, dt_ticks=dt, t_end_ticks=t_end,
         out_ticks=to_ticks("output_interval_s", spec.output_interval_s),
         update_ticks=to_ticks("controller_update_s", p.controller_update_s, allow_zero=True),
         pwm_ticks=to_ticks("pwm_period_s", p.pwm_period_s),
-        tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True))
+        tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
+        pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm))
     _check_output_size(spec, run)
     model = build_model(p)
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
@@ -317,7 +327,8 @@ def _run_with_progress(call, mech, t_end_s, progress):
 
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
              dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
-             hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage"):
+             hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
+             pwm=DEFAULT_PWM):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
@@ -337,8 +348,13 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         the PWM period), or amperes.
     t_end_s, dt_s, output_interval_s : float
         Simulated time, step and output sampling interval [s] (whole nanoseconds).
-    method : {"rk4", "euler"}
-        Fixed-step integrator (default :data:`DEFAULT_METHOD`, rk4).
+    method : {"rk4", "euler", "semi-implicit", "exponential", "authors-ode4"}
+        Fixed-step integrator (default :data:`DEFAULT_METHOD`, rk4; :mod:`.integrators`).
+        ``authors-ode4`` is the authors' Simulink solver: RK4 with the PWM read at its stages.
+    pwm : {"exact", "averaged"}
+        How the PWM drive is applied (:mod:`.pwm`): resolved at its edges (default), or its
+        period-averaged power (valid when the PWM period is far below the wire's thermal
+        time constant; allows steps of several PWM periods, docs/speed.md).
     tol_deg, tol_m, hold_s : float
         A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
         actuator) for ``hold_s``.
@@ -351,5 +367,5 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     SimulationResult
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
-                     tol_deg, hold_s, independent_wait, tol_m, drive)
+                     tol_deg, hold_s, independent_wait, tol_m, drive, pwm)
     return run_spec(spec, progress=progress)

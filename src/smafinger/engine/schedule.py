@@ -5,6 +5,7 @@ previous target has been reached" (within a tolerance, for a hold time). :func:`
 starts the segments that are due; :func:`track_reach` records when each target was reached.
 """
 
+import math
 from typing import NamedTuple
 
 from numba import njit
@@ -90,14 +91,23 @@ def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs
 
 
 @njit(cache=True, inline="always")
-def track_reach(s, t, q, tol, hold_ticks):
+def track_reach(s, t, q, tol, hold_ticks, t_prev, q_prev, locate):
     """Track whether the current target has been entered for good (within ``tol`` for ``hold_ticks``).
 
-    Returns (schedule, reached): ``reached`` is the tick at which the target of segment
-    ``next_seg - 1`` was entered, on the tick this is confirmed; -1 otherwise.
+    ``q`` is the coordinate at tick t, ``q_prev`` at ``t_prev`` (the step's start). The target is
+    entered at t, or, with ``locate``, where the line from q_prev to q crosses the band's edge
+    (long steps: the event located inside the step, not at its end). Returns (schedule, reached):
+    ``reached`` is the tick at which the target of segment ``next_seg - 1`` was entered, on the
+    tick this is confirmed; -1 otherwise.
     """
-    if abs(q - s.q_target) <= tol:
-        band = t if s.band_since < 0 else s.band_since
+    err = abs(q - s.q_target)
+    if err <= tol:
+        band = s.band_since
+        if band < 0:
+            band = t
+            err_prev = abs(q_prev - s.q_target)
+            if locate and err_prev > tol and t > t_prev:
+                band = t_prev + int(math.ceil((t - t_prev) * (err_prev - tol) / (err_prev - err)))
         reached = -1
         confirmed = s.confirmed
         if t - band >= hold_ticks and not confirmed:
@@ -106,3 +116,11 @@ def track_reach(s, t, q, tol, hold_ticks):
                 reached = band
         return with_field(with_field(s, "band_since", band), "confirmed", confirmed), reached
     return with_field(s, "band_since", -1), -1
+
+
+@njit(cache=True, inline="always")
+def confirm_tick(s, hold_ticks):
+    """The tick at which the current target will count as reached if q stays in the band (-1: none)."""
+    if s.band_since >= 0 and not s.confirmed:
+        return s.band_since + hold_ticks
+    return -1

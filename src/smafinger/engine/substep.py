@@ -16,7 +16,10 @@ from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.records import Inputs, State, WireInput, WireState
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
+from .authors import Stages
+from .clock import TICKS_PER_S
 from .integrators import step
+from .pwm import PwmModel, averaged_drive, sampled_drive
 from .rhs import derivative, geometry_at
 from .tuples import filled, set_item, with_field
 
@@ -97,18 +100,47 @@ def _update_kinetics(model, y, inputs, k1, aux, stacks):
 
 
 @njit(cache=True, inline="always")
-def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, mid, stuck):
-    """(inputs, drives) for a sub-step whose midpoint is ``mid`` ticks into the PWM period."""
-    low = 0.0 if run.current_drive else model.drive.V_L_V
+def _drive(run, c, low, phase):
+    """A wire's drive under command ``c`` at ``phase`` ticks into the PWM period (:mod:`.pwm`).
+
+    ``exact``: the wave at ``phase`` ticks (a sub-step's midpoint; sub-steps end at the edges);
+    ``averaged``: the period's RMS level; ``sampled``: the wave read ``phase`` seconds after the
+    period's reference time, as the authors' solver reads it (:func:`.pwm.sampled_phases`).
+    """
+    if run.pwm == PwmModel.AVERAGED:
+        return averaged_drive(c.level, low, c.duty)
+    if run.pwm == PwmModel.SAMPLED:
+        return sampled_drive(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks / TICKS_PER_S), phase)
+    return pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), phase)
+
+
+@njit(cache=True, inline="always")
+def _low(model, run):
+    """The drive between PWM pulses: V_L, or 0 A with a current drive."""
+    return 0.0 if run.current_drive else model.drive.V_L_V
+
+
+@njit(cache=True, inline="always")
+def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, phase, stuck):
+    """(inputs, drives, interlock drives) for a sub-step; ``phase``: where the drive is read.
+
+    The interlock drives are the resolved wave's: the sub-step's own with the exact PWM, the
+    levels at the period start (where every wire with a duty above 0 is on) otherwise.
+    """
+    low = _low(model, run)
     w = model.wires
     drives = filled(w, 0.0)
+    resolved = filled(w, 0.0)
     wis = inputs.wires
     for i in range(len(w)):
         c = cmds[i]
-        d = pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), mid)
+        d = _drive(run, c, low, phase)
         drives = set_item(drives, i, d)
-        wis = set_item(wis, i, WireInput(d, c.heating, wis[i].branch, wis[i].depth))
-    return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, low
+        if run.pwm != PwmModel.EXACT:
+            d = pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), 0.0)
+        resolved = set_item(resolved, i, d)
+        wis = set_item(wis, i, WireInput(drives[i], c.heating, wis[i].branch, wis[i].depth))
+    return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, resolved, low
 
 
 @njit(cache=True, inline="always")
@@ -134,18 +166,19 @@ def _finite(y):
 
 
 @njit(cache=True, inline="always")
-def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, ps, first, stuck, v_prev,
+def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck, v_prev,
            counters, stacks):
     """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, kinetics
-    branches (Eqs. 9-10), stick/slip (Eq. 2), and the derivative there.
+    branches (Eqs. 9-10), stick/slip (Eq. 2), and the derivative there. ``phase``: where the
+    PWM is read (:func:`_drive`).
 
     Returns (y, inputs, geom, geom_q, stuck, v_prev, counters, k1, aux, drives).
     """
     geom = geometry_at(y.q, geom_q, geom, model)
     geom_q = y.q
-    inputs, drives, low = _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating,
-                                       0.5 * (a + b) - ps, stuck)
-    if opposing_wires_driven(model.wires, drives, low) and b > a:
+    inputs, drives, resolved, low = _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating,
+                                                 phase, stuck)
+    if opposing_wires_driven(model.wires, resolved, low) and b > a:
         counters = with_field(counters, "violations", counters.violations + 1)
     # the derivative at the sub-step start; then the kinetics branches and Eq. (2) are decided from
     # it, and whenever a decision changes what the derivative depends on it is evaluated again
@@ -177,13 +210,17 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, inline="always")
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters):
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 
-    Returns (y, counters, t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
+    With the authors' solver the later stages read the controller and the PWM at their own
+    states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
+    schedule; see :func:`.authors.stage_inputs`). Returns (y, counters,
+    t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
     """
     if b > a:
-        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom)
+        stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end)
+        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):

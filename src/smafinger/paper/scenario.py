@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable
 
-from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, RunSpec, make_spec
+from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, RunSpec, make_spec
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
 from .claim import Claim
@@ -69,7 +69,7 @@ class Scenario:
              method: str = DEFAULT_METHOD, output_interval_s: float = DEFAULT_OUTPUT_S,
              tol_deg: float | None = None, hold_s: float | None = None, *, profile: str | None = None,
              t_end_s: float | None = None, independent_wait: bool | None = None,
-             strategy: str | None = None) -> RunSpec:
+             strategy: str | None = None, pwm: str = DEFAULT_PWM) -> RunSpec:
         """A validated :class:`~smafinger.engine.run.RunSpec` of this scenario.
 
         ``overrides`` (an :class:`Overrides` or ``NAME=VALUE`` strings) apply after the
@@ -83,7 +83,7 @@ class Scenario:
         run = {"strategy": self.strategy, "profile": self.profile, "t_end_s": self.t_end_s}
         run.update(ov.settings())
         return make_spec(ov.apply(get_params(self.params)), voltage=self.voltage, dt_s=dt_s,
-                         method=method, output_interval_s=output_interval_s, **run)
+                         method=method, output_interval_s=output_interval_s, pwm=pwm, **run)
 
     def definition(self) -> dict:
         """The scenario as plain values (for ``summary.json``)."""

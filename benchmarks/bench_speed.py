@@ -1,0 +1,209 @@
+"""Speed and accuracy of the engine's settings (issue 11): a script printing ratios, not a timed test.
+
+For each case, in one process, measured interleaved (so that load from elsewhere hits every
+setting alike) and printed as ratios:
+
+- ``today``: the engine's default (rk4, 1 ms, the PWM resolved at its edges), the baseline;
+- ``fast``: the long-step setting (exponential integrator, 5 ms, PWM averaged over its
+  period, reach events located inside steps) and a few neighbours;
+- the error of each against a reference run (rk4, 1 us, exact PWM edges): RMS and max of the
+  coordinate on the output grid, and the reach times.
+
+Cases: the paper's co-operative full cycle (Fig. 15, -40 -> -25 -> -55 -> -40 deg, 45 s,
+``paper2010``); the linear bias-spring rig's closed-loop cycle (10 mm, then 4 mm, 30 s);
+the authors' 2020 profile 2 (``authors2020``, independent, 20 s). Then the authors' solver
+(``authors-ode4``): the peak wire temperatures of their profiles 1 and 2 against their plots.
+
+Then the legacy engine (commit ff21ad0, before the engine redesign) as recorded on this kind
+of machine, the SciPy baseline (the test oracle's ``solve_ivp``, open loop: it has no
+controller), and the process-level times: ``smafinger --help``, a cached ``simulate`` (whole
+process) and, with ``--cold``, the first result after a fresh install (an empty numba cache).
+
+Usage::
+
+    PYTHONPATH=src python benchmarks/bench_speed.py [--repeat 7] [--ref-dt 1e-6] [--cold]
+
+Goals (issue 11): full cycle <= 2 ms engine loop at <= 0.05 deg RMS and <= 0.3 deg max error;
+``--help`` <= 0.3 s; cached ``simulate`` process <= 1 s; first result <= 10 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+SRC = HERE.parent / "src"
+sys.path.insert(0, str(SRC))
+sys.path.insert(0, str(HERE.parent / "tests"))
+
+from smafinger.engine.run import make_spec, run_spec  # noqa: E402
+from smafinger.parameters import get  # noqa: E402
+
+from oracle import simulate_baseline  # noqa: E402
+
+#: (label, params, strategy, profile, t_end_s, unit scale for the error, unit)
+CASES = (
+    ("paper2010 co-operative full cycle", "paper2010", "cooperative", "0:-25,reach:-55,reach:-40", 45.0),
+    ("linear bias-spring rig, closed loop", "linear-bias-spring", "cooperative", "0:0.010,15:0.004", 30.0),
+    ("authors2020 profile 2", "authors2020", "independent", "0:-25:upper,5:-55:both", 20.0),
+)
+TODAY = ("rk4", 1e-3, "exact")
+FAST = ("exponential", 5e-3, "averaged")
+SETTINGS = (TODAY, FAST, ("semi-implicit", 5e-3, "averaged"), ("exponential", 1e-2, "averaged"),
+            ("rk4", 1e-3, "averaged"))
+
+#: the legacy engine (commit ff21ad0), co-operative full cycle at rk4 / 1 ms, measured on this kind
+#: of machine (2 cores) interleaved with the redesigned engine before this work (issue 11's text)
+LEGACY = {"kernel_ms": (29.0, 31.0), "rms_deg": 0.0056, "substeps": 83260}
+
+
+def _spec(params, strategy, profile, t_end, setting):
+    method, dt, pwm = setting
+    return make_spec(params, strategy, profile, t_end_s=t_end, dt_s=dt, method=method, pwm=pwm)
+
+
+def _coordinate(r):
+    return r.theta_deg if r.spec.params.mechanism == "joint" else r.signal("position_m") * 1e3
+
+
+def _errors(r, ref):
+    e = _coordinate(r) - _coordinate(ref)
+    return float(np.sqrt(np.mean(e ** 2))), float(np.max(np.abs(e)))
+
+
+def _reached(r):
+    return [None if s["reached_s"] is None else round(s["reached_s"], 4) for s in r.metrics["segments"]]
+
+
+def bench_case(label, params, strategy, profile, t_end, repeat, ref_dt) -> dict:
+    unit = "deg" if get(params).mechanism == "joint" else "mm"
+    specs = {s: _spec(params, strategy, profile, t_end, s) for s in SETTINGS}
+    for sp in specs.values():
+        run_spec(sp)  # compile or load the cache, outside the timing
+    walls = {s: [] for s in SETTINGS}
+    results = {}
+    for _ in range(repeat):  # interleaved: every setting sees the same load
+        for s, sp in specs.items():
+            results[s] = run_spec(sp)
+            walls[s].append(results[s].wall_s)
+    t0 = time.perf_counter()
+    ref = run_spec(_spec(params, strategy, profile, t_end, ("rk4", ref_dt, "exact")))
+    t_ref = time.perf_counter() - t0
+    print(f"\n== {label}: {params}, {strategy}, '{profile}', {t_end:g} s simulated")
+    print(f"   reference: rk4 {ref_dt * 1e6:g} us, exact PWM ({ref.substeps} sub-steps, {t_ref:.0f} s); "
+          f"reached {_reached(ref)}")
+    base = min(walls[TODAY])
+    out = {}
+    for s in SETTINGS:
+        r = results[s]
+        rms, mx = _errors(r, ref)
+        best, med = min(walls[s]), statistics.median(walls[s])
+        tag = "today" if s == TODAY else ("fast " if s == FAST else "     ")
+        print(f"   {tag} {s[0]:13s} {s[1] * 1e3:4g} ms {s[2]:8s}: kernel {best * 1e3:7.2f} ms (median {med * 1e3:7.2f}), "
+              f"{r.substeps:6d} sub-steps, RATIO today/this {base / best:5.1f}x; "
+              f"error RMS {rms:.4f} {unit}, max {mx:.4f} {unit}; reached {_reached(r)}")
+        out[s] = {"best_s": best, "rms": rms, "max": mx}
+    return out
+
+
+def bench_legacy(paper: dict) -> None:
+    fast, today = paper[FAST], paper[TODAY]
+    lo, hi = LEGACY["kernel_ms"]
+    print(f"\n== legacy engine (ff21ad0, recorded): co-operative full cycle rk4 1 ms: {lo:g}-{hi:g} ms, "
+          f"{LEGACY['rms_deg']} deg RMS ({LEGACY['substeps']} sub-steps)")
+    print(f"   RATIO legacy/fast {lo / (fast['best_s'] * 1e3):.1f}-{hi / (fast['best_s'] * 1e3):.1f}x, "
+          f"legacy/today {lo / (today['best_s'] * 1e3):.2f}-{hi / (today['best_s'] * 1e3):.2f}x "
+          "(recorded numbers, not measured in this run: compare with care under load)")
+
+
+def bench_scipy(repeat: int) -> None:
+    """The open-loop case the SciPy baseline (tests/oracle) runs: upper wire at 8 V for 6 s, to 20 s."""
+    p = get("paper2010").replace(minor_loop_reversal_C=0.0)
+    voltage = "0:8:0,6:0:0"
+    t_ref, th_ref, info_ref = simulate_baseline(p, voltage, method="LSODA", rtol=1e-10)
+    _, _, info = simulate_baseline(p, voltage, method="RK45", rtol=1e-6)
+    print(f"\n== SciPy baseline (tests/oracle, solve_ivp RK45 rtol 1e-6): open loop '{voltage}', 20 s: "
+          f"{info['wall_s'] * 1e3:.0f} ms; reference LSODA rtol 1e-10")
+    for s in (TODAY, FAST):
+        sp = make_spec(p, "open-loop", voltage=voltage, t_end_s=20.0, dt_s=s[1], method=s[0], pwm=s[2],
+                       output_interval_s=0.01)
+        run_spec(sp)
+        best = min(run_spec(sp).wall_s for _ in range(repeat))
+        r = run_spec(sp)
+        err = float(np.nanmax(np.abs(r.theta_deg - th_ref)))
+        print(f"   {s[0]:13s} {s[1] * 1e3:g} ms {s[2]:8s}: kernel {best * 1e3:7.2f} ms, RATIO scipy/this "
+              f"{info['wall_s'] / best:6.0f}x; max |dtheta| vs LSODA {err:.4f} deg")
+
+
+#: the authors' 2020 profiles (paper/authors.py) and the published peak wire temperatures [degC]
+#: read off their plots (gabrielegilardi/FingerControl, Example<n>_Results_SMA<k>); None: not known
+AUTHORS_PROFILES = (
+    (1, "0:-25:upper,5:-40:none,10:-30:upper", {"upper": None, "lower": None}),
+    (2, "0:-25:upper,5:-55:both", {"upper": None, "lower": 135.0}),
+)
+
+
+def bench_authors() -> None:
+    """Issue 10 section 4: peak wire temperatures, resolved PWM against the authors' solver."""
+    print("\n== authors2020 peak wire temperatures (20 s): resolved PWM (rk4 1 ms exact) vs authors-ode4")
+    for number, profile, published in AUTHORS_PROFILES:
+        for method in ("rk4", "authors-ode4"):
+            r = run_spec(make_spec("authors2020", "independent", profile, t_end_s=20.0, method=method))
+            peaks = {w: float(np.max(r.signal(f"T_{w}_C"))) for w in published}
+            shown = ", ".join(f"{w} {t:6.1f} degC" + ("" if published[w] is None else
+                                                       f" (published {published[w]:g}, diff {t - published[w]:+.1f})")
+                              for w, t in peaks.items())
+            print(f"   profile {number} {method:13s}: {shown}")
+
+
+def _process_s(code: str, env: dict | None = None, repeat: int = 3) -> float:
+    best = float("inf")
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], check=True, env=env, capture_output=True)
+        best = min(best, time.perf_counter() - t0)
+    return best
+
+
+def bench_process(cold: bool) -> None:
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    run = ("from smafinger import simulate; simulate('paper2010', 'cooperative', '0:-25,reach:-55,reach:-40', "
+           "t_end_s=45.0)")
+    help_s = _process_s("import sys; sys.argv = ['smafinger', '--help']\nfrom smafinger.cli import _console\n"
+                        "try:\n    _console()\nexcept SystemExit:\n    pass", env)
+    import_s = _process_s("import smafinger", env)
+    cached_s = _process_s(run, env)
+    print("\n== process times (best of 3)")
+    print(f"   smafinger --help             : {help_s:6.2f} s   (goal <= 0.3 s; 'import smafinger' alone {import_s:.2f} s)")
+    print(f"   cached simulate, full cycle  : {cached_s:6.2f} s   (goal <= 1 s)")
+    if cold:
+        with tempfile.TemporaryDirectory() as tmp:
+            cold_s = _process_s(run, dict(env, NUMBA_CACHE_DIR=tmp), repeat=1)
+        print(f"   first result, empty cache    : {cold_s:6.1f} s   (goal <= 10 s)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--ref-dt", type=float, default=1e-6, help="reference step [s] (1e-6: minutes per case)")
+    ap.add_argument("--cold", action="store_true", help="also time a run with an empty numba cache")
+    args = ap.parse_args()
+    print(f"bench_speed: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} (1 min)")
+    results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
+    bench_legacy(results[CASES[0][0]])
+    bench_scipy(args.repeat)
+    bench_authors()
+    bench_process(args.cold)
+
+
+if __name__ == "__main__":
+    main()
