@@ -16,7 +16,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..control.controller import pid_commands, program_commands, viscous_coefficient
+from ..control.controller import program_commands, viscous_coefficient
+from ..control.interface import control_tick, initial_control_state
 from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
 from ..model.hysteresis_memory import STACK_COLUMNS
@@ -124,6 +125,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     y = initial_state(model)
     inputs = initial_inputs(model, run.current_drive)
     cmds = initial_commands(model)
+    ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
     s = Schedule(0, model.dynamics.q0, 0, -1, False, -1, -1, -1, False)
     geom = geometry(model, y.q)
     geom_q = y.q
@@ -152,7 +154,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
                 cmds = program_commands(cmds, prog.level[prog_i - 1], prog.duty[prog_i - 1])
                 next_event = _next_event(s, run, segs, prog, prog_i)
         elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
-            cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
+            cmds, integrating, ctl = control_tick(model.controller, ctl, model, s, y, inputs, geom, geom_q,
+                                                  t * run.tick_s, started)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
         t_next = _interval_end(t, run, cmds, next_event)
         ps = (t // run.pwm_ticks) * run.pwm_ticks
@@ -165,7 +168,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             first = False
             if j == 0 and t == next_out and out_i < n_out:
                 record_sample(mech_out, wire_out, out_i, a * run.tick_s, y, aux, s.q_target, s.next_seg - 1,
-                              stuck, cmds, drives)
+                              stuck, cmds, drives, model.wires, geom)
                 out_i += 1
                 next_out += run.out_ticks
             y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters)
