@@ -106,6 +106,10 @@ class ControllerParameters:
         given = [f"{n}={getattr(self, n):g}" for n in self.field_names() if getattr(self, n) is not None]
         return f"{self.label}({', '.join(given)})" if given else self.label
 
+    def prepared(self, p: ParameterSet) -> "ControllerParameters":
+        """This controller with whatever it needs from set ``p`` resolved once (a calibration)."""
+        return self
+
     def record(self, p: ParameterSet, base: Controller):
         """The compiled record for set ``p`` (``base``: the set's own PID gains, SI)."""
         raise NotImplementedError
@@ -221,8 +225,12 @@ class ResistanceFeedbackParameters(ControllerParameters):
     #: the resistance-to-position map; None: calibrated for the set when the record is built
     calibration: ResistanceCalibration | None = None
 
+    def prepared(self, p: ParameterSet) -> "ResistanceFeedbackParameters":
+        """Calibrated for ``p`` (:func:`~.calibration.calibrate`: a dozen short runs) if not yet."""
+        return self if self.calibration is not None else self.replace(calibration=calibrate(p))
+
     def record(self, p: ParameterSet, base: Controller) -> ControlChain:
-        cal = self.calibration if self.calibration is not None else calibrate(p)
+        cal = self.prepared(p).calibration
         if cal.wires != tuple(p.wire_names):
             raise ParameterError(f"{self.label}: the calibration is for wires {', '.join(cal.wires)}, the set "
                                  f"{p.name!r} has {', '.join(p.wire_names)}")

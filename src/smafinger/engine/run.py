@@ -89,7 +89,7 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
     if controller is not None:
-        controller = controller_from(controller)
+        controller = controller_from(controller).prepared(p)
         if strategy == "open-loop":
             raise ProfileError(f"a controller ({controller.label}) is only used in closed loop, not with open-loop")
     spec = RunSpec(p, strategy, profile, voltage, float(t_end_s), float(dt_s), method,
