@@ -58,3 +58,21 @@ def test_paper_pid_through_the_interface_is_bit_identical():
     a, b = run_spec(base), run_spec(via)
     for name in a.column_names:
         np.testing.assert_array_equal(a.signal(name), b.signal(name), err_msg=name)
+
+
+class ChainPID(PaperPID):
+    """The paper's PID law as a :class:`~smafinger.control.chain.ControlChain` (position sensor, no shaping)."""
+
+    def record(self, p, base):
+        from smafinger.control.chain import Law, PIDGains
+        from smafinger.control.params import chain
+
+        return chain(p, self.sensors, Law.PID, pid=PIDGains(*self._gains(base)))
+
+
+@pytest.mark.parametrize("strategy", ["independent", "cooperative"])
+def test_the_chain_with_the_pid_law_is_the_paper_pid_bit_for_bit(strategy):
+    a = run_spec(make_spec("paper2010", strategy, "0:-25,6:-55,12:-40", t_end_s=16.0))
+    b = run_spec(make_spec("paper2010", strategy, "0:-25,6:-55,12:-40", t_end_s=16.0, controller=ChainPID()))
+    for name in a.column_names:
+        np.testing.assert_array_equal(a.signal(name), b.signal(name), err_msg=name)

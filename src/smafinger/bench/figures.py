@@ -22,7 +22,7 @@ def _axes_label(rec) -> str:
 
 
 def task_figure(res: BenchResult, task: Task):
-    """(name, figure) of one task."""
+    """(name, PNG bytes) of one task."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -57,11 +57,11 @@ def task_figure(res: BenchResult, task: Task):
     axes[0, 0].legend(fontsize=8, loc="best")
     fig.suptitle(task.description, fontsize=9)
     fig.tight_layout()
-    return f"{task.mechanism}-{task.name}", fig
+    return f"{task.mechanism}-{task.name}", png(fig)
 
 
 def bandwidth_figure(res: BenchResult, mechanism: str, tasks: Sequence[Task]):
-    """(name, figure): the fitted gain of every sine task against its frequency (log-log)."""
+    """(name, PNG bytes): the fitted gain of every sine task against its frequency (log-log)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -82,10 +82,23 @@ def bandwidth_figure(res: BenchResult, mechanism: str, tasks: Sequence[Task]):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    return f"{mechanism}-bandwidth", fig
+    return f"{mechanism}-bandwidth", png(fig)
 
 
-def task_figures(res: BenchResult, tasks: Sequence[Task]) -> list:
+def png(fig) -> bytes:
+    """The figure as PNG bytes; the figure is closed."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def task_figures(res: BenchResult, tasks: Sequence[Task]) -> list[tuple[str, bytes]]:
+    """(name, PNG bytes) of every task's figure and of each mechanism's sine gains."""
     out = [task_figure(res, t) for t in tasks]
     for mech in dict.fromkeys(t.mechanism for t in tasks):
         if any(t.kind == "sine" and t.mechanism == mech for t in tasks):

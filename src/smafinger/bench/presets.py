@@ -39,7 +39,17 @@ ENTRIES: dict[str, Entry] = {
     "pid-tuned": Entry("pid", {"joint": PID_TUNED_JOINT}, {"joint": _TUNE.format(c="pid", b=40, p=_PID_BOX) + ", rounded to 4 digits"},
                        tuned=True),
     "fuzzy-pid": Entry("fuzzy-pid"),
+    "fuzzy-pid-tuned": Entry(
+        "fuzzy-pid",
+        {"joint": {"K_P_min_per_q": 443.1, "K_P_max_per_q": 2738.0, "K_V_min_s_per_q": 235.7,
+                   "K_V_max_s_per_q": 3322.0, "e_span_q": 0.3015, "de_span_q_s": 0.1145}},
+        {"joint": _TUNE.format(c="fuzzy-pid", b=40, p="(its default box)") + ", rounded to 4 digits"}, tuned=True),
     "sliding-mode": Entry("sliding-mode"),
+    "sliding-mode-tuned": Entry(
+        "sliding-mode",
+        {"joint": {"lambda_per_s": 2.295, "lambda_I_per_s2": 0.002929, "phi_q_per_s": 0.1084, "K_pct": 77.33}},
+        {"joint": _TUNE.format(c="sliding-mode", b=40, p="(its default box)") + ", rounded to 4 digits"},
+        tuned=True),
     "rapid-heating": Entry("rapid-heating"),
     "rapid-heating-tuned": Entry(
         "rapid-heating",

@@ -51,8 +51,8 @@ def task_table(rows: pd.DataFrame) -> str:
 def bandwidth_markdown(bw: pd.DataFrame) -> str:
     lines = ["| controller | strategy | -3 dB bandwidth [Hz] |", "|---|---|---|"]
     for _, r in bw.iterrows():
-        v = r["bandwidth_hz"]
-        shown = f"> {r['above_hz']:g}" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.3g}"
+        shown = {">": f"> {r['above_hz']:g}", "<=": f"≤ {r['below_hz']:g}"}.get(r["bound"],
+                                                                                 f"{r['bandwidth_hz']:.3g}")
         lines.append(f"| {r['controller']} | {r['strategy']} | {shown} |")
     return "\n".join(lines)
 
@@ -144,7 +144,7 @@ def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bo
     if figures:
         from .figures import task_figures
 
-        plots = task_figures(res, tasks)  # (name, figure), drawn before anything is written
+        plots = task_figures(res, tasks)  # (name, PNG bytes), drawn before anything is written
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, frame in (("controllers.csv", res.rows), ("bandwidth.csv", res.bandwidth)):
@@ -155,11 +155,8 @@ def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bo
     written += [out / "controllers.md", out / "goals.json"]
     if plots:
         (out / "figures").mkdir(exist_ok=True)
-        import matplotlib.pyplot as plt
-
-        for name, fig in plots:
+        for name, data in plots:
             path = out / "figures" / f"{name}.png"
-            atomic_write(path, lambda tmp, f=fig: f.savefig(tmp, format="png", dpi=110))
-            plt.close(fig)
+            atomic_write(path, lambda tmp, d=data: Path(tmp).write_bytes(d))
             written.append(path)
     return written

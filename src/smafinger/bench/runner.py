@@ -102,12 +102,16 @@ def bandwidth_table(rows: pd.DataFrame, tasks: Sequence[Task]) -> pd.DataFrame:
     freq = {(t.mechanism, t.name): t.frequency_hz for t in tasks if t.kind == "sine"}
     out = []
     if rows.empty or "gain" not in rows:
-        return pd.DataFrame(columns=["mechanism", "controller", "strategy", "bandwidth_hz", "below_hz", "above_hz"])
+        return pd.DataFrame(columns=["mechanism", "controller", "strategy", "bandwidth_hz", "bound", "below_hz",
+                                     "above_hz"])
     sines = rows[rows["kind"] == "sine"]
     for (mech, label, strategy), g in sines.groupby(["mechanism", "controller", "strategy"], sort=False):
         fs = [freq[(mech, n)] for n in g["task"]]
-        out.append({"mechanism": mech, "controller": label, "strategy": strategy,
-                    "bandwidth_hz": bandwidth_hz(fs, list(g["gain"])), "below_hz": min(fs), "above_hz": max(fs)})
+        bw = bandwidth_hz(fs, list(g["gain"]))
+        # "<=": already below -3 dB at the lowest frequency tried; ">": never below (bandwidth_hz None)
+        bound = ">" if bw is None else "<=" if bw == min(fs) else "="
+        out.append({"mechanism": mech, "controller": label, "strategy": strategy, "bandwidth_hz": bw,
+                    "bound": bound, "below_hz": min(fs), "above_hz": max(fs)})
     return pd.DataFrame(out)
 
 

@@ -5,7 +5,8 @@ paper's PWM-PID's on the same task (so 0.5 is twice as good as the paper): the c
 a ``cycle`` task, the RMS tracking error for the others. Constraints are penalties added to
 it: each unreached target 1.0, each interlock violation 1.0, and 0.1 per degC by which the
 hottest wire exceeds ``max_peak_T_C`` (default: the paper's PID's own peak on the same tasks,
-so a tuned controller may not heat the wires more than the paper's does).
+so a tuned controller may not heat the wires more than the paper's does). A candidate whose
+values are inconsistent (a fuzzy K_P_min above K_P_max) is not run and scores :data:`INVALID`.
 
 Free parameters (:class:`FreeParam`) live in a box; gains are searched on a log scale. Every
 candidate is an ordinary bench run (:func:`smafinger.engine.batch.run_batch`), so a tuning is
@@ -23,7 +24,7 @@ import numpy as np
 from ..control.params import CONTROLLERS, ControllerParameters, PaperPID
 from ..engine.batch import make_pool, run_batch
 from ..model.build import build_model
-from ..parameters import ParameterSet
+from ..parameters import ParameterError, ParameterSet
 from .runner import OUTPUT_S, warm_kernels
 from .scores import record_of, task_scores
 from .tasks import Task
@@ -32,6 +33,8 @@ from .tasks import Task
 UNREACHED_PENALTY = 1.0
 VIOLATION_PENALTY = 1.0
 HEAT_PENALTY_PER_C = 0.1
+#: the objective of a candidate whose values are inconsistent (no run made)
+INVALID = 100.0
 
 
 @dataclass(frozen=True)
@@ -136,10 +139,26 @@ def _specs(tasks, controllers, strategy) -> list:
             for c in controllers for t in tasks]
 
 
-def _scores(tasks, controllers, strategy, pool) -> list[list[dict]]:
-    recs = run_batch(_specs(tasks, controllers, strategy), reduce=record_of, pool=pool)
-    n = len(tasks)
-    return [[task_scores(t, r) for t, r in zip(tasks, recs[k * n:(k + 1) * n])] for k in range(len(controllers))]
+def _scores(tasks, controllers, strategy, pool) -> list[list[dict] | None]:
+    """Each controller's scores per task; ``None`` for a controller whose values are inconsistent
+    (e.g. a fuzzy K_P_min above its K_P_max: a :class:`ParameterError` when its record is built)."""
+    valid = []
+    for c in controllers:
+        try:
+            _specs(tasks, [c], strategy)
+            valid.append(c)
+        except ParameterError:
+            valid.append(None)
+    ok = [c for c in valid if c is not None]
+    recs = run_batch(_specs(tasks, ok, strategy), reduce=record_of, pool=pool) if ok else []
+    n, out, k = len(tasks), [], 0
+    for c in valid:
+        if c is None:
+            out.append(None)
+        else:
+            out.append([task_scores(t, r) for t, r in zip(tasks, recs[k * n:(k + 1) * n])])
+            k += 1
+    return out
 
 
 def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "cooperative",
@@ -180,7 +199,7 @@ def _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, po
         xs = es.ask()
         cands = [base.replace(**{f.name: f.value(u) for f, u in zip(free, x)}) for x in xs]
         all_scores = _scores(tasks, cands, strategy, pool)
-        fs = [objective(tasks, s, reference, limit) for s in all_scores]
+        fs = [INVALID if s is None else objective(tasks, s, reference, limit) for s in all_scores]
         es.tell(xs, fs)
         evaluations += len(xs)
         k = int(np.argmin(fs))
