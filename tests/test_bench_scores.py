@@ -33,6 +33,10 @@ def test_bandwidth_of_a_first_order_lag():
     assert bandwidth_hz([1.0, 4.0], [1.0, 0.25]) == pytest.approx(math.sqrt(2.0), rel=1e-12)
     assert bandwidth_hz([0.1, 0.2], [0.9, 0.8]) is None  # never falls below: above the highest
     assert bandwidth_hz([0.1, 0.2], [0.5, 0.4]) == 0.1  # below already at the lowest
+    # a dip at a low frequency does not count: the last crossing does
+    assert bandwidth_hz([0.5, 1.0, 4.0, 8.0], [0.3, 1.0, 0.25, 0.1]) == pytest.approx(math.sqrt(2.0), rel=1e-12)
+    # a run that did not move (gain 0) is floored, not dropped
+    assert 0.02 < bandwidth_hz([0.02, 0.05], [0.94, 0.0]) < 0.021
 
 
 def _record(t, q, q_ref, segments, unit="deg", T=None, violations=0, energy=12.5):

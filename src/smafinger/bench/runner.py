@@ -70,7 +70,8 @@ def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
                     controllers[(mech, label)] = ctrl
     keyed = bench_specs(tasks, controllers, strategies)
     warm_kernels(spec for _, spec in keyed)
-    say(f"{len(keyed)} runs ({len(tasks)} tasks x {len(labels)} controllers x {len(strategies)} strategies)")
+    say(f"{len(keyed)} runs: {len(tasks)} tasks, {len(labels)} controllers (tuned entries on their own mechanism "
+        f"only), {len(strategies)} strategies")
     outcomes = run_batch([spec for _, spec in keyed], workers=workers, reduce=record_of)
     by_name = {(t.mechanism, t.name): t for t in tasks}
     rows, records = [], {}

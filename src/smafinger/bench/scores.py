@@ -32,6 +32,8 @@ from .tasks import HOLD_WINDOW_S, Task
 SETTLE_BAND = {"deg": 0.5, "m": 0.2e-3}
 #: user unit -> the unit the bench reports (the slider's metres as millimetres)
 REPORT_SCALE = {"deg": (1.0, "deg"), "m": (1e3, "mm")}
+#: the smallest gain used in the bandwidth's log-log interpolation
+GAIN_FLOOR = 1e-6
 
 
 def sine_fit(t: np.ndarray, x: np.ndarray, frequency_hz: float) -> tuple[float, float, float]:
@@ -134,16 +136,23 @@ def _segment_scores(t, q, segments, unit: str, scale: float) -> dict:
 
 
 def bandwidth_hz(frequencies: list[float], gains: list[float]) -> float | None:
-    """The -3 dB bandwidth: the first frequency where the gain falls below 1/sqrt(2), interpolated
-    in log-log between the two sine tasks around it; ``None`` if it never falls that low (the
-    bandwidth is then above the highest frequency tried)."""
-    pts = sorted((f, g) for f, g in zip(frequencies, gains) if g is not None and g > 0.0)
+    """The -3 dB bandwidth: above the highest frequency whose gain is at least 1/sqrt(2), where
+    the gain falls below it for good, interpolated in log-log between that sine task and the
+    next (a dip at a lower frequency, e.g. from stick-slip at a slow sine, does not count).
+    ``None`` if no frequency tried falls below (the bandwidth is above the highest); the lowest
+    frequency if none reaches the level (the bandwidth is at most that). Gains are floored at
+    :data:`GAIN_FLOOR` (a run that did not move at all) for the interpolation."""
+    pts = sorted((f, max(float(g), GAIN_FLOOR)) for f, g in zip(frequencies, gains)
+                 if g is not None and math.isfinite(g))
+    if not pts:
+        return None
     level = 1.0 / math.sqrt(2.0)
-    for k, (f, g) in enumerate(pts):
-        if g < level:
-            if k == 0:
-                return f  # already below at the lowest frequency: at most this
-            f0, g0 = pts[k - 1]
-            x = (math.log(level) - math.log(g0)) / (math.log(g) - math.log(g0))
-            return float(math.exp(math.log(f0) + x * (math.log(f) - math.log(f0))))
-    return None
+    above = [k for k, (_, g) in enumerate(pts) if g >= level]
+    if not above:
+        return pts[0][0]
+    k = above[-1]
+    if k == len(pts) - 1:
+        return None
+    (f0, g0), (f1, g1) = pts[k], pts[k + 1]
+    x = (math.log(level) - math.log(g0)) / (math.log(g1) - math.log(g0))
+    return float(math.exp(math.log(f0) + x * (math.log(f1) - math.log(f0))))
