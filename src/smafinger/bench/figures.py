@@ -43,7 +43,7 @@ def task_figure(res: BenchResult, task: Task):
             scale = REPORT_SCALE[rec.unit][0]
             t = rec.t[::EVERY]
             if i == 0:
-                top.plot(t, rec.q_ref[::EVERY] * scale, "k--", lw=1.0, label="target")
+                top.plot(t, rec.q_ref[::EVERY] * scale, "k--", lw=1.0, label=f"target ({label})")
             c = colours[i % len(colours)]
             top.plot(t, rec.q[::EVERY] * scale, color=c, lw=1.2, label=label)
             hottest = np.max(np.vstack([T[::EVERY] for T in rec.T_C.values()]), axis=0)
