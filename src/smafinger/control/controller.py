@@ -15,6 +15,30 @@ from .strategies import Command, is_enabled, wire_command
 
 
 @njit(cache=True, inline="always")
+def phase_commands(model, enabled, u, q_target, q, level):
+    """One signed controller output u [%] as a command per wire: the phase selection of Sec. 2.6.
+
+    A direction +1 wire gets clamp(u), a direction -1 wire clamp(-u), each only if enabled and
+    in its heating phase (or kept on in cooling, ``controller_in_cooling``); ``q`` is the
+    controller's idea of the coordinate (measured, or estimated by a self-sensing controller).
+    """
+    keep_on = model.options.controller_in_cooling
+    w = model.wires
+    cmds = filled(w, Command(False, False, 0.0, level))
+    for i in range(len(w)):
+        cmds = set_item(cmds, i, wire_command(u, is_enabled(enabled, i), w[i].direction, q_target, q,
+                                              keep_on, level))
+    return cmds
+
+
+@njit(cache=True, inline="always")
+def integrating_flag(model, u, e):
+    """1.0 while the error integral runs, 0.0 while anti-windup freezes it (Eq. 12a)."""
+    frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)
+    return 0.0 if frozen else 1.0
+
+
+@njit(cache=True, inline="always")
 def pid_commands(model, enabled, q_target, state, level):
     """(commands, integrating): the PID (Eq. 12a) and the phase selection of Sec. 2.6.
 
@@ -23,14 +47,20 @@ def pid_commands(model, enabled, q_target, state, level):
     c = model.controller
     e = q_target - state.q
     u = pid_output(e, -state.v, state.error_integral, c.K_P, c.K_V, c.K_I)
-    keep_on = model.options.controller_in_cooling
-    w = model.wires
-    cmds = filled(w, Command(False, False, 0.0, level))
-    for i in range(len(w)):
-        cmds = set_item(cmds, i, wire_command(u, is_enabled(enabled, i), w[i].direction, q_target, state.q,
-                                              keep_on, level))
-    frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)
-    return cmds, 0.0 if frozen else 1.0
+    return phase_commands(model, enabled, u, q_target, state.q, level), integrating_flag(model, u, e)
+
+
+@njit(cache=True, inline="always")
+def pid_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
+    """The paper's PWM-PID as a controller (:mod:`.interface`): no state of its own, every sensor
+    exact (it reads the plant state: q, q' and the error integral)."""
+    cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
+    return cmds, integrating, cstate
+
+
+@njit(cache=True)
+def pid_initial(ctrl, model):
+    return ()
 
 
 @njit(cache=True, inline="always")

@@ -18,7 +18,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..control.controller import pid_commands, program_commands, viscous_coefficient
+from ..control.controller import program_commands, viscous_coefficient
+from ..control.interface import control_tick, initial_control_state
 from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
 from ..model.hysteresis_memory import STACK_COLUMNS
@@ -99,13 +100,14 @@ def _sub_bounds(t, t_next, ps, cmds, run, bounds):
 
 
 @njit(cache=True, inline="always")
-def _flush(mo, wo, out_i, next_out, run, a, final, prev, now):
+def _flush(mo, wo, out_i, next_out, run, wires, a, final, prev, now):
     """Write the output samples due before sub-step start ``a`` (and at ``a`` on the final pass).
 
-    ``prev`` and ``now`` are (tick, state, aux, cmds, drives, stuck, q_target, segment) at the
-    previous sub-step start and at ``a``. A sample at ``prev``'s tick takes its values, one in
-    between interpolates them (:func:`.dense.interpolated`); one at ``a`` takes ``now``'s. With
-    the exact PWM every sample falls on a sub-step start. Returns (out_i, next_out).
+    ``prev`` and ``now`` are (tick, state, aux, cmds, drives, stuck, q_target, segment, geometry)
+    at the previous sub-step start and at ``a``. A sample at ``prev``'s tick takes its values, one
+    in between interpolates the state (:func:`.dense.interpolated`) and keeps ``prev``'s tendon
+    geometry (for the wire resistance); one at ``a`` takes ``now``'s. With the exact PWM every
+    sample falls on a sub-step start. Returns (out_i, next_out).
     """
     n_out = mo.shape[0]
     while out_i < n_out and (next_out < a or (final and next_out == a)):
@@ -113,7 +115,8 @@ def _flush(mo, wo, out_i, next_out, run, a, final, prev, now):
         y, aux = src[1], src[2]
         if next_out != a and next_out != prev[0]:
             y, aux = interpolated(prev[1], prev[2], now[1], now[2], (next_out - prev[0]) / (a - prev[0]))
-        record_sample(mo, wo, out_i, float(next_out) * run.tick_s, y, aux, src[6], src[7], src[5], src[3], src[4])
+        record_sample(mo, wo, out_i, float(next_out) * run.tick_s, y, aux, src[6], src[7], src[5], src[3], src[4],
+                      wires, src[8])
         out_i += 1
         next_out += run.out_ticks
     return out_i, next_out
@@ -153,6 +156,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     y = initial_state(model)
     inputs = initial_inputs(model, run.current_drive)
     cmds = initial_commands(model)
+    ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
     s = Schedule(0, model.dynamics.q0, 0, -1, False, -1, -1, -1, False)
     geom = geometry(model, y.q)
     geom_q = y.q
@@ -160,7 +164,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     bounds = np.empty(len(model.wires) + 1)
     stacks = np.zeros((len(model.wires), STACK_CAPACITY, STACK_COLUMNS))  # reversal points, per wire
     n_out = mech_out.shape[0]
-    prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1)
+    prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1, geom)
     integrating = 1.0
     pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)
     locate = run.pwm == PwmModel.AVERAGED  #: long steps: reach events located inside a step
@@ -184,7 +188,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
                 cmds = program_commands(cmds, prog.level[prog_i - 1], prog.duty[prog_i - 1])
                 next_event = _next_event(s, run, segs, prog, prog_i)
         elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
-            cmds, integrating = pid_commands(model, s.enabled, s.q_target, y, model.drive.V_H_V)
+            cmds, integrating, ctl = control_tick(model.controller, ctl, model, s, y, inputs, geom, geom_q,
+                                                  t * run.tick_s, started)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
         event = next_event
         if locate:  # long steps: one ends where the target will count as reached
@@ -204,10 +209,10 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
                 model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck,
                 v_prev, counters, stacks)
             first = False
-            now = (int(a), y, aux, cmds, drives, stuck, s.q_target, s.next_seg - 1)
+            now = (int(a), y, aux, cmds, drives, stuck, s.q_target, s.next_seg - 1, geom)
             final = t >= run.t_end_ticks
             if out_i < n_out and (next_out < a or (final and next_out == a)):
-                out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, a, final, prev, now)
+                out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
             y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
                                             phase_mid, phase_end)

@@ -12,6 +12,7 @@ from pathlib import PurePath
 import numpy as np
 from numba import typeof
 
+from ..control.params import ControllerParameters, controller_from
 from ..control.strategies import STRATEGIES, enable_mask
 from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
@@ -57,6 +58,8 @@ class RunSpec:
     independent_wait: bool
     tol_m: float = DEFAULT_TOL_M  #: target tolerance of the linear actuator [m]
     pwm: str = DEFAULT_PWM  #: how the PWM drive is applied (engine.pwm): exact or averaged
+    #: the closed-loop controller (control.params); None: the paper's PWM-PID with the set's gains
+    controller: ControllerParameters | None = None
 
     @property
     def tolerance(self) -> float:
@@ -67,7 +70,7 @@ class RunSpec:
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
               t_end_s=20.0, dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S,
               tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage",
-              pwm=DEFAULT_PWM) -> RunSpec:
+              pwm=DEFAULT_PWM, controller=None) -> RunSpec:
     """A validated :class:`RunSpec` (see :func:`simulate` for the arguments).
 
     Raises ``TypeError`` for an argument of the wrong type and ``ValueError`` (or its
@@ -101,9 +104,13 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     for name, v in (("tol_deg", tol_deg), ("tol_m", tol_m), ("hold_s", hold_s)):
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
+    if controller is not None:
+        controller = controller_from(controller).prepared(p)
+        if strategy == "open-loop":
+            raise ProfileError(f"a controller ({controller.label}) is only used in closed loop, not with open-loop")
     spec = RunSpec(p, strategy, profile, voltage, float(t_end_s), float(dt_s), method,
                    float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m),
-                   pwm)
+                   pwm, controller)
     kernel_args(spec)  # validates the times, targets and program against the mechanism
     return spec
 
@@ -227,6 +234,8 @@ def kernel_args(spec: RunSpec) -> dict:
         pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm))
     _check_output_size(spec, run)
     model = build_model(p)
+    if spec.controller is not None:
+        model = model._replace(controller=spec.controller.record(p, model.controller))
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
@@ -234,14 +243,15 @@ class _CompiledKernels:
     """The kernel compiled (or loaded from numba's cache) once per mechanism, then called directly.
 
     numba types every argument at every call, and typing the nested records costs about a
-    millisecond; their types depend only on the mechanism (every value is a float, every option
-    an enum member), so the entry point is looked up once per mechanism and wire count.
+    millisecond; their types depend only on the mechanism and the controller's record type
+    (every value is a float, every option an enum member), so the entry point is looked up once
+    per mechanism, wire count and controller.
     """
 
     def __init__(self) -> None:
-        self._entry: dict[tuple[str, int], object] = {}
+        self._entry: dict[tuple, object] = {}
 
-    def __call__(self, key: tuple[str, int], args: tuple):
+    def __call__(self, key: tuple, args: tuple):
         fn = self._entry.get(key)
         if fn is None:
             sig = tuple(typeof(a) for a in args)
@@ -273,7 +283,8 @@ def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
     seg_actual = np.full(n_seg, -1, dtype=np.int64)
     seg_reached = np.full(n_seg, -1, dtype=np.int64)
     call_args = _kernel_args_tuple(args, mech, wires, seg_actual, seg_reached)
-    kernel = _kernels((spec.params.mechanism, n_wires), call_args)  # compiles outside the timing
+    key = (spec.params.mechanism, n_wires, type(args["model"].controller))
+    kernel = _kernels(key, call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress is True or isinstance(progress, Display):
         counters, state, t_fail = _run_with_progress(lambda: kernel(*call_args), mech, spec.t_end_s, progress)
@@ -328,7 +339,7 @@ def _run_with_progress(call, mech, t_end_s, progress):
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
              dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
              hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
-             pwm=DEFAULT_PWM):
+             pwm=DEFAULT_PWM, controller=None):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
@@ -361,11 +372,14 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     independent_wait : bool
         Independent strategy: wait for the previous agonist's cooling phase to end before
         using the other actuator (Sec. 4.1).
+    controller : str or ControllerParameters, optional
+        The closed-loop controller (:mod:`smafinger.control.params`: ``pid``, ``fuzzy-pid``,
+        ``sliding-mode``, ``rapid-heating``, ``resistance``); default the paper's PWM-PID.
 
     Returns
     -------
     SimulationResult
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
-                     tol_deg, hold_s, independent_wait, tol_m, drive, pwm)
+                     tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
     return run_spec(spec, progress=progress)

@@ -17,6 +17,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ..model.resistance import wire_resistance, wire_strain
+
 
 @dataclass(frozen=True)
 class Signal:
@@ -54,6 +56,9 @@ SIGNALS: tuple[Signal, ...] = (
     Signal("heating", True, "1", "heating_{wire}", doc="1 in its controller's heating phase (Sec. 2.6)"),
     Signal("stuck", False, "1", "stuck", doc="1 while held by static friction or an end stop (Eq. 2)"),
     Signal("segment", False, "1", "segment", doc="index of the profile segment in force"),
+    # --- added with the controllers (issue 15) ----------------------------------------------
+    Signal("R", True, "ohm", "R_{wire}_ohm",
+           doc="whole-wire resistance, phase and temperature dependent (model.resistance): what self-sensing reads"),
 )
 
 MECHANISM_FIELDS = tuple(s.field for s in SIGNALS if not s.per_wire)
@@ -110,8 +115,11 @@ def kernel_views(mech: np.ndarray, wires: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 @njit(cache=True, inline="always")
-def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives):
-    """Write output sample ``i``: every signal, by its column (a test checks none is left NaN)."""
+def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives, wires, geom):
+    """Write output sample ``i``: every signal, by its column (a test checks none is left NaN).
+
+    ``wires``: the model's wire records, ``geom`` the geometry at the state (for the resistance).
+    """
     mo[i, MC.t] = t_s
     mo[i, MC.q] = state.q
     mo[i, MC.q_ref] = q_target
@@ -135,3 +143,5 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
         wo[i, w, WC.T_case] = ws.T_case_C
         wo[i, w, WC.enabled] = 1.0 if cmds[w].enabled else 0.0
         wo[i, w, WC.heating] = 1.0 if cmds[w].heating else 0.0
+        strain = wire_strain(wires[w], geom.routes[w][0], wa.spring_m)
+        wo[i, w, WC.R] = wire_resistance(wires[w], ws.T_C, wa.xi, strain)

@@ -93,6 +93,19 @@ class ParameterSet:
         0.0, 1.0, "emissivity of the wire's surface for radiative loss (0: off, as in the paper; "
         "polished NiTi: about 0.1-0.3)", wire=True, default=0.0)
 
+    # --- electrical resistance as sensed (model.resistance, Eqs. R1-R2; not Eq. 11's R_w) ---
+    # defaults: the MAS model's values for actuator NiTi wire (docs/controllers.md, "Self-sensing")
+    resistivity_austenite_ohm_m: float = _num(
+        1e-8, 1e-4, "resistivity of austenite at resistivity_reference_C", wire=True, default=8.9e-7)
+    resistivity_martensite_ohm_m: float = _num(
+        1e-8, 1e-4, "resistivity of (detwinned) martensite at resistivity_reference_C", wire=True, default=1.02e-6)
+    resistivity_tc_austenite_per_K: float = _num(
+        -1e-2, 1e-2, "temperature coefficient of the austenite resistivity", wire=True, default=2e-4)
+    resistivity_tc_martensite_per_K: float = _num(
+        -1e-2, 1e-2, "temperature coefficient of the martensite resistivity", wire=True, default=3e-4)
+    resistivity_reference_C: float = _num(
+        -100.0, 300.0, "temperature at which the two resistivities are given", wire=True, default=20.0)
+
     # --- drive and controller (Eq. 12, Sec. 2.6) -------------------------------------------
     V_H_V: float = _num(0.0, 100.0, "PWM high voltage V_H (the supply)")
     V_L_V: float = _num(0.0, 100.0, "PWM low voltage V_L")

@@ -1,0 +1,106 @@
+"""A figure per bench task, like the paper's: the coordinate against its target for every
+controller (one column per strategy), and below it the hottest wire's temperature; and the
+gain of the sine tasks against frequency, per mechanism."""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from .runner import BenchResult
+from .scores import REPORT_SCALE
+from .tasks import Task
+
+#: figures are drawn from every n-th sample (the bench samples every 10 ms)
+EVERY = 5
+
+
+def _axes_label(rec) -> str:
+    scale, unit = REPORT_SCALE[rec.unit]
+    return f"{'angle' if rec.unit == 'deg' else 'position'} [{unit}]"
+
+
+def task_figure(res: BenchResult, task: Task):
+    """(name, PNG bytes) of one task."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    keys = [k for k in res.records if k[0] == task.mechanism and k[1] == task.name]
+    strategies = list(dict.fromkeys(k[3] for k in keys))
+    controllers = list(dict.fromkeys(k[2] for k in keys))
+    fig, axes = plt.subplots(2, len(strategies), figsize=(6.0 * len(strategies), 6.0), sharex=True, squeeze=False,
+                             gridspec_kw={"height_ratios": (2, 1)})
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for j, strategy in enumerate(strategies):
+        top, bottom = axes[0, j], axes[1, j]
+        for i, label in enumerate(controllers):
+            rec = res.records.get((task.mechanism, task.name, label, strategy))
+            if rec is None:
+                continue
+            scale = REPORT_SCALE[rec.unit][0]
+            t = rec.t[::EVERY]
+            if i == 0:
+                top.plot(t, rec.q_ref[::EVERY] * scale, "k--", lw=1.0, label=f"target ({label})")
+            c = colours[i % len(colours)]
+            top.plot(t, rec.q[::EVERY] * scale, color=c, lw=1.2, label=label)
+            hottest = np.max(np.vstack([T[::EVERY] for T in rec.T_C.values()]), axis=0)
+            bottom.plot(t, hottest, color=c, lw=1.0)
+            top.set_ylabel(_axes_label(rec))
+        top.set_title(f"{task.name}: {strategy}")
+        bottom.set_ylabel("hottest wire [°C]")
+        bottom.set_xlabel("time [s]")
+        top.grid(alpha=0.3)
+        bottom.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=8, loc="best")
+    fig.suptitle(task.description, fontsize=9)
+    fig.tight_layout()
+    return f"{task.mechanism}-{task.name}", png(fig)
+
+
+def bandwidth_figure(res: BenchResult, mechanism: str, tasks: Sequence[Task]):
+    """(name, PNG bytes): the fitted gain of every sine task against its frequency (log-log)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    freq = {t.name: t.frequency_hz for t in tasks if t.mechanism == mechanism and t.kind == "sine"}
+    rows = res.rows[(res.rows["mechanism"] == mechanism) & (res.rows["task"].isin(list(freq)))]
+    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    for (label, strategy), g in rows.groupby(["controller", "strategy"], sort=False):
+        f = [freq[n] for n in g["task"]]
+        ax.plot(f, g["gain"], "o-" if strategy == "cooperative" else "s--", label=f"{label} ({strategy})", lw=1.0)
+    ax.axhline(1.0 / np.sqrt(2.0), color="k", lw=0.8, ls=":", label="-3 dB")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("gain (fitted amplitude / reference)")
+    ax.set_title(f"{mechanism}: sine tracking")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return f"{mechanism}-bandwidth", png(fig)
+
+
+def png(fig) -> bytes:
+    """The figure as PNG bytes; the figure is closed."""
+    import io
+
+    import matplotlib.pyplot as plt
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def task_figures(res: BenchResult, tasks: Sequence[Task]) -> list[tuple[str, bytes]]:
+    """(name, PNG bytes) of every task's figure and of each mechanism's sine gains."""
+    out = [task_figure(res, t) for t in tasks]
+    for mech in dict.fromkeys(t.mechanism for t in tasks):
+        if any(t.kind == "sine" and t.mechanism == mech for t in tasks):
+            out.append(bandwidth_figure(res, mech, tasks))
+    return out

@@ -1,0 +1,158 @@
+"""The bench's plant for learned controllers: a step-by-step session and a Gymnasium environment.
+
+:class:`PlantSession` advances the plant one control interval at a time with a duty per wire
+(a fraction of the supply V_H, switched at the PWM period: the engine's ``duty`` drive
+program, strategy ``open-loop``), and returns what the controllers of the bench may measure:
+the coordinate and its rate (user unit), each wire's resistance and, if declared, its
+temperature. The engine runs whole programs, so each step re-runs the program so far from
+t = 0 (deterministic: the state after step k is bit-identical to one open-loop run of the same
+k steps; the cost of an episode grows with the square of its length, about 10 s for 200
+steps of 0.1 s on the joint).
+
+:func:`make_env` wraps it as a ``gymnasium.Env`` (the optional extra:
+``pip install 'smafinger[gym]'``): action: a duty per wire in [0, 1]; observation: the
+measured signals and the target, in the order of :attr:`PlantSession.observation_names`;
+reward: minus the tracking error |q - q_F| (user unit) times the interval, less
+``heat_penalty`` per degC by which any wire exceeds ``max_T_C`` and ``interlock_penalty`` for
+a step that drives two opposing wires at once (the interlock of Sec. 2.6 is the policy's job
+here). A learned policy is then compared on the same plant and tasks as the built-in
+controllers (docs/controllers.md).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..engine.run import make_spec, run_spec
+from ..parameters import ParameterSet
+from ..parameters import get as get_params
+from ..profiles import VoltageProgram
+
+
+class PlantSession:
+    """One episode of the plant, advanced a control interval at a time (see the module docstring)."""
+
+    def __init__(self, params: str | ParameterSet = "paper2010", target: float | None = None,
+                 control_interval_s: float = 0.1, episode_s: float = 20.0, temperature_sensors: bool = False,
+                 overrides: tuple[str, ...] = ()):
+        p = get_params(params) if isinstance(params, str) else params
+        self.params = p.with_overrides(list(overrides)) if overrides else p
+        for name, v in (("control_interval_s", control_interval_s), ("episode_s", episode_s)):
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} = {v!r} must be a finite number > 0")
+        self.dt = float(control_interval_s)
+        self.n_steps = int(round(episode_s / self.dt))
+        self.target = float(self.params.initial_target if target is None else target)
+        self.temperature_sensors = bool(temperature_sensors)
+        self.wires = tuple(self.params.wire_names)
+        c = self.params.coordinate
+        self._q, self._v = f"{c.name}_{c.unit}", None
+        self.steps: list[tuple[float, ...]] = []
+        self.result = None
+
+    @property
+    def observation_names(self) -> tuple[str, ...]:
+        c = self.params.coordinate
+        temps = tuple(f"T_{w}_C" for w in self.wires) if self.temperature_sensors else ()
+        return (f"{c.name}_{c.unit}", f"rate_{c.unit}_s", *(f"R_{w}_ohm" for w in self.wires), *temps,
+                f"target_{c.unit}")
+
+    def reset(self) -> np.ndarray:
+        self.steps, self.result = [], None
+        return self.observe()
+
+    @property
+    def t_s(self) -> float:
+        return len(self.steps) * self.dt
+
+    @property
+    def done(self) -> bool:
+        return len(self.steps) >= self.n_steps
+
+    def step(self, duties) -> np.ndarray:
+        """Apply ``duties`` (one per wire, each in [0, 1]) for one control interval."""
+        d = np.asarray(duties, dtype=float).reshape(-1)
+        if d.size != len(self.wires):
+            raise ValueError(f"duties: {d.size} value(s) given, the mechanism has {len(self.wires)} wires "
+                             f"({', '.join(self.wires)})")
+        for w, x in zip(self.wires, d):
+            if not (math.isfinite(x) and 0.0 <= x <= 1.0):
+                raise ValueError(f"duty of wire {w} = {float(x)!r} must be in [0, 1]")
+        self.steps.append((self.t_s, *map(float, d)))
+        spec = make_spec(self.params, "open-loop", voltage=VoltageProgram(tuple(self.steps), "duty"),
+                         t_end_s=self.t_s, output_interval_s=self.dt)
+        self.result = run_spec(spec)
+        return self.observe()
+
+    def signal(self, name: str) -> float:
+        """The last sample of an output signal (0 before the first step, except the initial state)."""
+        return float(self.result.signal(name)[-1])
+
+    def observe(self) -> np.ndarray:
+        if self.result is None:  # the initial state: the first sample of any run (zero duty here)
+            zero = VoltageProgram(((0.0,) + (0.0,) * len(self.wires),), "duty")
+            probe = run_spec(make_spec(self.params, "open-loop", voltage=zero, t_end_s=self.dt,
+                                       output_interval_s=self.dt))
+            first = {n: float(probe.signal(n)[0]) for n in probe.column_names}
+            get = first.__getitem__
+            rate = 0.0
+        else:
+            get = self.signal
+            rate = float(self.result.signal(self._rate_name())[-1])
+        q = get(self._q)
+        R = [get(f"R_{w}_ohm") for w in self.wires]
+        T = [get(f"T_{w}_C") for w in self.wires] if self.temperature_sensors else []
+        return np.array([q, rate, *R, *T, self.target], dtype=np.float64)
+
+    def _rate_name(self) -> str:
+        c = self.params.coordinate
+        return next(n for n in self.result.column_names if n.endswith(f"_{c.unit}_s"))
+
+    def hottest_T_C(self) -> float:
+        """The hottest wire now [degC]."""
+        return max(self.signal(f"T_{w}_C") for w in self.wires) if self.result is not None else -math.inf
+
+    def interlock_violations(self) -> int:
+        return int(self.result.interlock_violations) if self.result is not None else 0
+
+
+def make_env(**kwargs: Any):
+    """A ``gymnasium.Env`` around :class:`PlantSession` (keyword arguments: the session's, and
+    ``max_T_C`` (default 110 degC), ``heat_penalty`` (1 per degC), ``interlock_penalty`` (1))."""
+    try:
+        import gymnasium
+        from gymnasium import spaces
+    except ImportError:
+        raise ImportError("the Gymnasium environment needs the optional extra: pip install 'smafinger[gym]'") from None
+
+    max_T = float(kwargs.pop("max_T_C", 110.0))
+    heat_w = float(kwargs.pop("heat_penalty", 1.0))
+    lock_w = float(kwargs.pop("interlock_penalty", 1.0))
+
+    class SMAPlantEnv(gymnasium.Env):
+        metadata = {"render_modes": []}
+
+        def __init__(self):
+            self.session = PlantSession(**kwargs)
+            n = len(self.session.wires)
+            self.action_space = spaces.Box(0.0, 1.0, shape=(n,), dtype=np.float64)
+            k = len(self.session.observation_names)
+            self.observation_space = spaces.Box(-np.inf, np.inf, shape=(k,), dtype=np.float64)
+
+        def reset(self, *, seed=None, options=None):
+            super().reset(seed=seed)
+            return self.session.reset(), {"t_s": 0.0}
+
+        def step(self, action):
+            s = self.session
+            before = s.interlock_violations()
+            obs = s.step(np.clip(np.asarray(action, dtype=float), 0.0, 1.0))
+            reward = -abs(obs[0] - s.target) * s.dt
+            reward -= heat_w * max(0.0, s.hottest_T_C() - max_T)
+            reward -= lock_w * (s.interlock_violations() > before)
+            return obs, float(reward), s.done, False, {"t_s": s.t_s, "hottest_T_C": s.hottest_T_C()}
+
+    return SMAPlantEnv()

@@ -1,0 +1,210 @@
+"""Tune a controller's gains on bench tasks: CMA-ES (``cma``) over a box, each generation one batch.
+
+The objective of a candidate is the mean over its tasks of the task's measure divided by the
+paper's PWM-PID's on the same task (so 0.5 is twice as good as the paper): the cycle time for
+a ``cycle`` task, the RMS tracking error for the others. Constraints are penalties added to
+it: each unreached target 1.0, each interlock violation 1.0, and 0.1 per degC by which the
+hottest wire exceeds ``max_peak_T_C`` (default: the paper's PID's own peak on the same tasks,
+so a tuned controller may not heat the wires more than the paper's does). A candidate whose
+values are inconsistent (a fuzzy K_P_min above K_P_max) is not run and scores :data:`INVALID`.
+
+Free parameters (:class:`FreeParam`) live in a box; gains are searched on a log scale. Every
+candidate is an ordinary bench run (:func:`smafinger.engine.batch.run_batch`), so a tuning is
+deterministic for a given seed and independent of the number of workers.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Callable, Sequence
+
+import numpy as np
+
+from ..control.params import CONTROLLERS, ControllerParameters, PaperPID
+from ..engine.batch import make_pool, run_batch
+from ..model.build import build_model
+from ..parameters import ParameterError, ParameterSet
+from .runner import OUTPUT_S, warm_kernels
+from .scores import record_of, task_scores
+from .tasks import Task
+
+#: penalty weights (objective units: 1.0 = the paper's PID on a task)
+UNREACHED_PENALTY = 1.0
+VIOLATION_PENALTY = 1.0
+HEAT_PENALTY_PER_C = 0.1
+#: the objective of a candidate whose values are inconsistent (no run made)
+INVALID = 100.0
+
+
+@dataclass(frozen=True)
+class FreeParam:
+    """A tuned field, searched in [lo, hi] (on a log scale if ``log``)."""
+
+    name: str
+    lo: float
+    hi: float
+    log: bool = False
+
+    def __post_init__(self):
+        if not (math.isfinite(self.lo) and math.isfinite(self.hi) and self.lo < self.hi):
+            raise ValueError(f"{self.name}: bounds {self.lo:g}:{self.hi:g} must be finite with lo < hi")
+        if self.log and self.lo <= 0.0:
+            raise ValueError(f"{self.name}: a log-scale bound must be positive, not {self.lo:g}")
+
+    def value(self, u: float) -> float:
+        """The value at position u in [0, 1] of the box."""
+        u = min(max(u, 0.0), 1.0)
+        if self.log:
+            return math.exp(math.log(self.lo) + u * (math.log(self.hi) - math.log(self.lo)))
+        return self.lo + u * (self.hi - self.lo)
+
+    def position(self, v: float) -> float:
+        if self.log:
+            return (math.log(v) - math.log(self.lo)) / (math.log(self.hi) - math.log(self.lo))
+        return (v - self.lo) / (self.hi - self.lo)
+
+    @classmethod
+    def parse(cls, text: str) -> "FreeParam":
+        """``NAME=LO:HI`` (linear) or ``NAME=LO:HI:log``."""
+        try:
+            name, rng = text.split("=", 1)
+            parts = rng.split(":")
+            log = len(parts) == 3 and parts[2].strip().lower() == "log"
+            if len(parts) not in (2, 3) or (len(parts) == 3 and not log):
+                raise ValueError
+            return cls(name.strip(), float(parts[0]), float(parts[1]), log)
+        except ValueError:
+            raise ValueError(f"--param {text!r} is not NAME=LO:HI or NAME=LO:HI:log") from None
+
+
+def default_free(label: str, p: ParameterSet) -> tuple[FreeParam, ...]:
+    """The fields tuned by default, their boxes scaled from the set's own PID gains."""
+    g = build_model(p).controller
+    kp, kv, ki = (max(x, 1e-9) for x in (g.K_P, g.K_V, g.K_I))
+    pid = (FreeParam("K_P_per_q", kp / 10, kp * 10, True), FreeParam("K_V_s_per_q", kv / 30, kv * 3, True),
+           FreeParam("K_I_per_q_s", ki / 10, ki * 30, True))
+    if label in ("pid", "resistance"):
+        return pid
+    if label == "fuzzy-pid":
+        return (FreeParam("K_P_min_per_q", kp / 10, kp * 3, True), FreeParam("K_P_max_per_q", kp / 3, kp * 10, True),
+                FreeParam("K_V_min_s_per_q", kv / 100, kv, True), FreeParam("K_V_max_s_per_q", kv / 30, kv * 3, True),
+                FreeParam("e_span_q", 30 / kp, 3000 / kp, True), FreeParam("de_span_q_s", 30 / kv, 3000 / kv, True))
+    if label == "sliding-mode":
+        return (FreeParam("lambda_per_s", 0.1, 20.0, True), FreeParam("lambda_I_per_s2", 1e-3, 1.0, True),
+                FreeParam("phi_q_per_s", 1.0 / kv, 1000.0 / kv, True), FreeParam("K_pct", 20.0, 100.0))
+    if label == "rapid-heating":
+        return pid + (FreeParam("boost_V", p.V_H_V, 2.0 * p.V_H_V), FreeParam("boost_until_C", p.A_S0_C - 30.0,
+                                                                             p.A_F0_C))
+    raise ValueError(f"controller {label!r} is not one of {', '.join(CONTROLLERS)}")
+
+
+@dataclass
+class TuneResult:
+    label: str
+    values: dict  #: the best candidate's free fields
+    objective: float
+    scores: list  #: the best candidate's scores per task
+    reference: list  #: the paper's PID's scores per task
+    max_peak_T_C: float
+    evaluations: int
+    history: list = field(default_factory=list)  #: best objective after each generation
+
+    def controller(self, base: ControllerParameters) -> ControllerParameters:
+        return base.replace(**self.values)
+
+
+def task_measure(task: Task, scores: dict) -> float | None:
+    """The measure a task is tuned on: its cycle time (cycle tasks) or its RMS error."""
+    return scores.get("cycle_s") if task.kind == "cycle" else scores["rms_error"]
+
+
+def objective(tasks: Sequence[Task], scores: Sequence[dict], reference: Sequence[dict], max_peak_T_C: float) -> float:
+    """The tuning objective of one candidate (see the module docstring)."""
+    total = 0.0
+    for task, s, ref in zip(tasks, scores, reference):
+        m, m_ref = task_measure(task, s), task_measure(task, ref)
+        if m is None:  # a cycle never completed: as slow as the whole run, and penalised
+            m = task.t_end_s
+        total += m / m_ref if m_ref else m
+        total += UNREACHED_PENALTY * s.get("unreached", 0) + VIOLATION_PENALTY * s["interlock_violations"]
+        total += HEAT_PENALTY_PER_C * max(0.0, s["peak_T_C"] - max_peak_T_C)
+    return total / len(tasks)
+
+
+def _specs(tasks, controllers, strategy) -> list:
+    from ..engine.run import make_spec
+
+    return [make_spec(t.params(), strategy, t.profile, t_end_s=t.t_end_s, output_interval_s=OUTPUT_S, controller=c)
+            for c in controllers for t in tasks]
+
+
+def _scores(tasks, controllers, strategy, pool) -> list[list[dict] | None]:
+    """Each controller's scores per task; ``None`` for a controller whose values are inconsistent
+    (e.g. a fuzzy K_P_min above its K_P_max: a :class:`ParameterError` when its record is built)."""
+    valid = []
+    for c in controllers:
+        try:
+            _specs(tasks, [c], strategy)
+            valid.append(c)
+        except ParameterError:
+            valid.append(None)
+    ok = [c for c in valid if c is not None]
+    recs = run_batch(_specs(tasks, ok, strategy), reduce=record_of, pool=pool) if ok else []
+    n, out, k = len(tasks), [], 0
+    for c in valid:
+        if c is None:
+            out.append(None)
+        else:
+            out.append([task_scores(t, r) for t, r in zip(tasks, recs[k * n:(k + 1) * n])])
+            k += 1
+    return out
+
+
+def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "cooperative",
+         free: Sequence[FreeParam] | None = None, max_peak_T_C: float | None = None, budget: int = 120,
+         popsize: int = 10, seed: int = 1, workers: int | None = None,
+         report: Callable[[str], None] | None = None) -> TuneResult:
+    """CMA-ES on the free fields of ``base`` over ``tasks`` (one mechanism); see the module docstring."""
+    say = report or (lambda msg: None)
+    mechs = {t.mechanism for t in tasks}
+    if len(mechs) != 1:
+        raise ValueError(f"tune on one mechanism at a time, not {', '.join(sorted(mechs))}")
+    p = tasks[0].params()
+    base = base.prepared(p)
+    free = tuple(free) if free is not None else default_free(base.label, p)
+    known = set(base.field_names())
+    for f in free:
+        if f.name not in known:
+            raise ValueError(f"{base.label} has no tunable field {f.name!r} (known: {', '.join(sorted(known))})")
+    warm_kernels(_specs(tasks[:1], [PaperPID(), base], strategy))  # compiled once here, loaded by the workers
+    with make_pool(workers) as pool:
+        return _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, pool, say)
+
+
+def _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, pool, say) -> TuneResult:
+    import cma
+
+    reference = _scores(tasks, [PaperPID()], strategy, pool)[0]
+    limit = max(s["peak_T_C"] for s in reference) if max_peak_T_C is None else float(max_peak_T_C)
+    say(f"paper's PID: {', '.join(f'{t.name} {task_measure(t, s):.4g}' for t, s in zip(tasks, reference))}; "
+        f"peak temperature limit {limit:.2f} degC")
+    x0 = [min(max(f.position(getattr(base, f.name)), 0.0), 1.0) if getattr(base, f.name) is not None else 0.5
+          for f in free]
+    es = cma.CMAEvolutionStrategy(x0, 0.25, {"bounds": [0.0, 1.0], "popsize": popsize, "seed": seed,
+                                             "maxfevals": budget, "verbose": -9})
+    best = (math.inf, None, None)
+    history, evaluations = [], 0
+    while not es.stop():
+        xs = es.ask()
+        cands = [base.replace(**{f.name: f.value(u) for f, u in zip(free, x)}) for x in xs]
+        all_scores = _scores(tasks, cands, strategy, pool)
+        fs = [INVALID if s is None else objective(tasks, s, reference, limit) for s in all_scores]
+        es.tell(xs, fs)
+        evaluations += len(xs)
+        k = int(np.argmin(fs))
+        if fs[k] < best[0]:
+            best = (fs[k], {f.name: f.value(u) for f, u in zip(free, xs[k])}, all_scores[k])
+        history.append(best[0])
+        say(f"{evaluations} evaluations: best objective {best[0]:.4f}")
+    return TuneResult(base.label, best[1], best[0], best[2], reference, limit, evaluations, history)

@@ -1,0 +1,106 @@
+"""The resistance-to-position map of the self-sensing controller (Eq. S1 of :mod:`.selfsensing`).
+
+Calibrated once, as on a bench, with a position sensor: the actuator makes a step from rest to
+each of a set of targets in closed loop (the paper's PWM-PID, one wire at a time: the
+independent strategy of Sec. 4.1), and the samples of each hold after :data:`SETTLE_S`
+give (R_i, q). The cubic map of Eq. (S1) is fitted to them by linear least squares
+(``numpy.linalg.lstsq``) on r_i = R_i / R_ref,i - 1, R_ref,i being wire i's resistance at rest.
+The fit's residuals are kept (the estimate's accuracy on the calibration holds).
+
+Why holds after steps from rest, not a sweep: the resistance sees the wire, not the mechanism.
+At one position the wire's resistance differs with its history (temperature, through the
+resistivity's temperature coefficients; the martensite fraction, through the phase
+resistivities; on the joint the series spring's elongation), so a map fitted to a slow sweep is
+off by degrees at the holds a controller makes. Fitted where it is used, it is right to tenths
+of a degree there (docs/controllers.md, "Self-sensing").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..parameters.base import ParameterSet
+from ..parameters.errors import ParameterError
+
+#: calibration targets, in the mechanism's user unit: each is a step from rest, then held
+CALIBRATION_TARGETS = {
+    "joint": (-34.0, -32.0, -30.0, -28.0, -26.0, -25.0, -46.0, -48.0, -50.0, -52.0, -54.0, -55.0),
+    "linear-bias-spring": (0.002, 0.004, 0.006, 0.008, 0.010, 0.012, 0.014, 0.016),
+}
+#: each step is held this long [s]; samples from SETTLE_S on are fitted
+STEP_S = 12.0
+SETTLE_S = 6.0
+#: polynomial degree of Eq. (S1) in each wire's r_i
+DEGREE = 3
+
+
+@dataclass(frozen=True)
+class ResistanceCalibration:
+    """Eq. (S1): q_hat = c0 + sum_i (c1_i r_i + c2_i r_i^2 + c3_i r_i^3), q in SI (rad or m)."""
+
+    wires: tuple[str, ...]
+    R_ref_ohm: tuple[float, ...]
+    c0: float
+    c1: tuple[float, ...]
+    c2: tuple[float, ...]
+    c3: tuple[float, ...]
+    rms_error: float  #: on the calibration run [q]
+    max_error: float  #: [q]
+
+    def estimate(self, R_ohm: np.ndarray) -> np.ndarray:
+        """q_hat for resistances ``R_ohm`` (samples x wires)."""
+        R = np.atleast_2d(np.asarray(R_ohm, dtype=float))
+        q = np.full(R.shape[0], self.c0)
+        for i in range(len(self.wires)):
+            r = R[:, i] / self.R_ref_ohm[i] - 1.0
+            q += r * (self.c1[i] + r * (self.c2[i] + r * self.c3[i]))
+        return q
+
+
+def _design(R: np.ndarray, R_ref: np.ndarray) -> np.ndarray:
+    r = R / R_ref - 1.0
+    cols = [np.ones(len(R))] + [r[:, i] ** k for i in range(R.shape[1]) for k in range(1, DEGREE + 1)]
+    return np.column_stack(cols)
+
+
+def fit_calibration(wires: tuple[str, ...], q: np.ndarray, R_ohm: np.ndarray,
+                    R_ref_ohm: np.ndarray | None = None) -> ResistanceCalibration:
+    """Least-squares fit of Eq. (S1) to samples of q (SI) and R (samples x wires)."""
+    q = np.asarray(q, dtype=float)
+    R = np.atleast_2d(np.asarray(R_ohm, dtype=float))
+    if R.shape != (len(q), len(wires)):
+        raise ParameterError(f"calibration: R has shape {R.shape}, expected ({len(q)}, {len(wires)})")
+    ok = np.isfinite(q) & np.isfinite(R).all(axis=1)
+    if ok.sum() < 1 + DEGREE * len(wires):
+        raise ParameterError(f"calibration: {int(ok.sum())} usable samples, too few for {1 + DEGREE * len(wires)} "
+                             "coefficients")
+    q, R = q[ok], R[ok]
+    R_ref = R[0] if R_ref_ohm is None else np.asarray(R_ref_ohm, dtype=float)
+    A = _design(R, R_ref)
+    coef, *_ = np.linalg.lstsq(A, q, rcond=None)
+    res = A @ coef - q
+    per_wire = coef[1:].reshape(len(wires), DEGREE)
+    return ResistanceCalibration(tuple(wires), tuple(float(x) for x in R_ref), float(coef[0]),
+                                 *(tuple(float(x) for x in per_wire[:, k]) for k in range(DEGREE)),
+                                 rms_error=float(np.sqrt(np.mean(res**2))), max_error=float(np.max(np.abs(res))))
+
+
+def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strategy: str = "independent",
+              output_interval_s: float = 0.01) -> ResistanceCalibration:
+    """Steps from rest to each target (user unit; default :data:`CALIBRATION_TARGETS`) with the paper's
+    PID and a position sensor, and the fit of Eq. (S1) to the settled samples."""
+    from ..engine.run import simulate
+
+    targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else targets
+    coord = f"{p.coordinate.name}_{p.coordinate.unit}"
+    qs, Rs, R_ref = [], [], None
+    for target in targets:
+        r = simulate(p, strategy, f"0:{target:g}", t_end_s=STEP_S, output_interval_s=output_interval_s)
+        R = np.column_stack([r.signal(f"R_{w}_ohm") for w in p.wire_names])
+        R_ref = R[0] if R_ref is None else R_ref
+        keep = r.t >= SETTLE_S
+        qs.append(r.signal(coord)[keep] * p.to_si(1.0))  # deg -> rad for the joint (a scale)
+        Rs.append(R[keep])
+    return fit_calibration(tuple(p.wire_names), np.concatenate(qs), np.vstack(Rs), R_ref)

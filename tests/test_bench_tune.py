@@ -1,0 +1,74 @@
+"""Tuning: the search box, the objective on constructed scores, and a tiny tuning end to end."""
+
+import json
+import math
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from smafinger.bench.tasks import Task
+from smafinger.bench.tune import (HEAT_PENALTY_PER_C, UNREACHED_PENALTY, VIOLATION_PENALTY, FreeParam,
+                                  objective)
+from smafinger.cli_bench import app
+
+
+@settings(max_examples=50, deadline=None)
+@given(lo=st.floats(1e-3, 10.0), span=st.floats(1.01, 1e4), u=st.floats(0.0, 1.0), log=st.booleans())
+def test_free_param_position_inverts_value(lo, span, u, log):
+    f = FreeParam("K", lo, lo * span, log)
+    v = f.value(u)
+    assert f.lo * (1 - 1e-12) <= v <= f.hi * (1 + 1e-12)
+    assert f.position(v) == pytest.approx(u, abs=1e-9)
+
+
+def test_free_param_parse_and_errors():
+    assert FreeParam.parse("K_P_per_q=10:100:log") == FreeParam("K_P_per_q", 10.0, 100.0, True)
+    assert FreeParam.parse("K_pct=20:100") == FreeParam("K_pct", 20.0, 100.0, False)
+    for bad in ("K=1", "K=1:2:lin", "K=a:b"):
+        with pytest.raises(ValueError, match="NAME=LO:HI"):
+            FreeParam.parse(bad)
+    with pytest.raises(ValueError, match="lo < hi"):
+        FreeParam("K", 2.0, 1.0)
+    with pytest.raises(ValueError, match="positive"):
+        FreeParam("K", 0.0, 1.0, True)
+
+
+def test_objective_is_relative_measure_plus_penalties():
+    cyc = Task("c", "joint", "cycle", "", 60.0, "c")
+    mov = Task("m", "joint", "move", "", 20.0, "m")
+    ref = [{"cycle_s": 10.0, "rms_error": 9.0}, {"rms_error": 2.0}]
+    good = [{"cycle_s": 6.0, "rms_error": 1.0, "unreached": 0, "interlock_violations": 0, "peak_T_C": 100.0},
+            {"rms_error": 1.0, "unreached": 0, "interlock_violations": 0, "peak_T_C": 90.0}]
+    assert objective([cyc, mov], good, ref, 100.0) == pytest.approx((0.6 + 0.5) / 2)
+    bad = [dict(good[0], cycle_s=None, unreached=1, peak_T_C=110.0), dict(good[1], interlock_violations=2)]
+    expected = (60.0 / 10.0 + UNREACHED_PENALTY + 10.0 * HEAT_PENALTY_PER_C + 0.5 + 2 * VIOLATION_PENALTY) / 2
+    assert objective([cyc, mov], bad, ref, 100.0) == pytest.approx(expected)
+
+
+def test_a_tiny_tuning_end_to_end(tmp_path):
+    out = tmp_path / "tuned.json"
+    r = CliRunner().invoke(app, ["tune", "pid", "-m", "linear-bias-spring", "-t", "sine-0.5hz", "--budget", "4",
+                                 "--popsize", "2", "-w", "1", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(out.read_text())
+    assert set(doc["values"]) == {"K_P_per_q", "K_V_s_per_q", "K_I_per_q_s"}
+    assert doc["evaluations"] >= 4 and math.isfinite(doc["objective"])
+    # the best objective never gets worse from one generation to the next
+    assert all(b <= a for a, b in zip(doc["history"], doc["history"][1:]))
+
+
+@pytest.mark.parametrize("args, names", [
+    (["pi", "-t", "fig15-cycle"], "controller 'pi'"),
+    (["pid", "-t", "fig15-cycle", "--budget", "0"], "--budget 0"),
+    (["pid", "-t", "fig15-cycle", "-p", "K_P_per_q=1"], "NAME=LO:HI"),
+    (["pid", "-t", "fig15-cycle", "-p", "K_pct=1:2"], "K_pct"),
+])
+def test_tune_bad_input_is_one_line_exit_2(tmp_path, args, names):
+    out = tmp_path / "never.json"
+    r = CliRunner().invoke(app, ["tune", *args, "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    lines = [x for x in r.output.splitlines() if x.strip()]
+    assert len(lines) == 1 and names in lines[0]
+    assert not out.exists()
