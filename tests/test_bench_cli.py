@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 from smafinger.bench.presets import QUICK_CONTROLLERS
 from smafinger.bench.tasks import select_tasks
-from smafinger.cli_bench import app
+from smafinger.cli import app
 from smafinger.control.params import PaperPID
 from smafinger.engine.run import make_spec, run_spec
 

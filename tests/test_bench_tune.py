@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 from smafinger.bench.tasks import Task
 from smafinger.bench.tune import (HEAT_PENALTY_PER_C, UNREACHED_PENALTY, VIOLATION_PENALTY, FreeParam,
                                   objective)
-from smafinger.cli_bench import app
+from smafinger.cli import app
 
 
 @settings(max_examples=50, deadline=None)

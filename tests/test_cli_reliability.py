@@ -172,7 +172,7 @@ def test_help_lists_the_allowed_values(capsys):
 
 def test_every_command_is_mounted_explicitly():
     names = {c.name for c in app.registered_commands} | {g.name for g in app.registered_groups}
-    assert names == {"simulate", "params", "scenarios", "reproduce", "sweep", "identify"}
+    assert names == {"simulate", "params", "scenarios", "reproduce", "sweep", "identify", "bench-controllers", "tune"}
     from smafinger.cli.identify import app as identify
 
     assert {c.callback.__name__ for c in identify.registered_commands} == {"kinetics", "joint", "actuator"}

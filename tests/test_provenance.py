@@ -27,6 +27,9 @@ from smafinger.provenance import (ProvenanceError, definition_hash, provenance, 
     (("paper2010-table2", "open-loop", None, "0:8:0,6:0:0"), dict(dt_s=5e-4, method="euler")),
     (("linear-bias-spring", "open-loop", None, "0:0.25,3:0"), dict(drive="duty", tol_m=1e-4)),
     (("linear-bias-spring", "open-loop", None, "0:0.2,2:0"), dict(drive="current")),
+    (("paper2010", "cooperative", "0:-25"), dict(method="exponential", dt_s=5e-3, pwm="averaged")),
+    (("paper2010", "cooperative", "0:-25"), dict(controller="sliding-mode")),
+    (("paper2010", "independent", "0:-25"), dict(controller="resistance")),
 ])
 def test_a_definition_rebuilds_the_same_spec(args, kw):
     spec = make_spec(*args, t_end_s=4.0, **kw)

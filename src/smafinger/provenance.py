@@ -50,6 +50,8 @@ def run_definition(spec) -> dict[str, Any]:
         "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method, "pwm": spec.pwm,
         "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg, "tol_m": spec.tol_m,
         "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
+        # the closed-loop controller (control.params) by label and values; None: the paper's PWM-PID
+        "controller": None if spec.controller is None else spec.controller.to_dict(),
     }
 
 
@@ -93,9 +95,22 @@ def spec_from_definition(definition: Any, where: str = "run definition"):
         p = from_dict({"mechanism": definition["mechanism"], **params})
         run = {k: definition[k] for k in RUN_KEYS if k != "drive"}
         return make_spec(p, voltage=None if drive is None else drive["program"],
-                         drive="voltage" if drive is None else drive["kind"], **run)
+                         drive="voltage" if drive is None else drive["kind"],
+                         controller=_controller(definition.get("controller")), **run)
     except (ParameterError, ValueError, TypeError) as exc:
         raise ProvenanceError(f"{where}: {exc}") from None
+
+
+def _controller(entry: Any):
+    """The controller object of a definition's ``controller`` entry (None: the paper's PWM-PID)."""
+    from .control.params import controller_from
+
+    if entry is None:
+        return None
+    if not isinstance(entry, dict) or not isinstance(entry.get("controller"), str):
+        raise ValueError(f"controller = {entry!r} is not {{controller: LABEL, ...values}} or null")
+    values = {k: v for k, v in entry.items() if k != "controller"}
+    return controller_from(entry["controller"]).replace(**values)
 
 
 def spec_from_provenance(record: Any, where: str = "provenance"):

@@ -1,4 +1,5 @@
-"""Command-line interface: ``smafinger simulate | params | scenarios | reproduce | identify | sweep``.
+"""Command-line interface: ``smafinger simulate | params | scenarios | reproduce | identify | sweep |
+bench-controllers | tune``.
 
 Each command is a thin function in its own module here (parse the options, call the API,
 print); they are mounted below by explicit imports, so a broken import fails loudly. Errors
@@ -12,8 +13,9 @@ import sys
 
 import typer
 
+from .bench import bench_controllers, tune
 from .common import help_when_bare
-from .errors import run_app
+from .errors import NOTHING_WRITTEN, command, run_app
 from .identify import app as identify_app
 from .params import params
 from .reproduce import reproduce, scenarios
@@ -25,7 +27,7 @@ app = typer.Typer(
     invoke_without_command=True,
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
-    help="Simulate, control and identify SMA tendon-driven finger joints (Gilardi et al. 2010).",
+    help="Simulate, control and identify SMA wire actuators: the tendon-driven finger joint of Gilardi et al. 2010 and a bias-spring rig.",
 )
 app.callback()(help_when_bare)
 app.command("simulate")(simulate)
@@ -34,6 +36,8 @@ app.command("scenarios")(scenarios)
 app.command("reproduce")(reproduce)
 app.add_typer(identify_app, name="identify", help="Fit model parameters to measured data.")
 app.command("sweep")(sweep)
+app.command("bench-controllers")(command(interrupted=NOTHING_WRITTEN)(bench_controllers))
+app.command("tune")(command(interrupted=NOTHING_WRITTEN)(tune))
 
 
 def main(argv: list[str] | None = None) -> int:

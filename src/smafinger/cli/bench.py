@@ -2,7 +2,7 @@
 
 Typer command functions, mounted by :mod:`smafinger.cli` (``app.command("bench-controllers")(
 bench_controllers)``, ``app.command("tune")(tune)``); a small app of both is ``app`` here
-(``python -m smafinger.cli_bench --help``).
+(mounted in :mod:`smafinger.cli`: ``smafinger bench-controllers``, ``smafinger tune``).
 
 Exit status: 0 done; 2 bad input (one line naming the option and the value, nothing written);
 1 the runs could not complete (a worker pool broke).
@@ -31,7 +31,7 @@ def _say(msg: str) -> None:
 
 
 def _tasks(mechanisms: list[str], names: list[str], quick: bool = False):
-    from .bench.tasks import select_tasks
+    from ..bench.tasks import select_tasks
 
     try:
         return select_tasks(tuple(mechanisms or MECHANISMS), tuple(names or ()), quick)
@@ -60,10 +60,10 @@ def bench_controllers(
     (-3 dB bandwidth), on the joint and on the linear actuator (docs/controllers.md). The
     Markdown table is printed too.
     """
-    from .bench.presets import BENCH_CONTROLLERS, QUICK_CONTROLLERS
-    from .bench.report import markdown, write_report
-    from .bench.runner import STRATEGIES, run_bench
-    from .engine.batch import BatchError
+    from ..bench.presets import BENCH_CONTROLLERS, QUICK_CONTROLLERS
+    from ..bench.report import markdown, write_report
+    from ..bench.runner import STRATEGIES, run_bench
+    from ..engine.batch import BatchError
 
     bad = [c for c in controller if c not in BENCH_CONTROLLERS]
     if bad:
@@ -114,12 +114,12 @@ def tune(
     the paper's PWM-PID on the same task, plus penalties for unreached targets, interlock
     violations and heat above the limit (docs/controllers.md, "Tuning").
     """
-    from .bench.runner import STRATEGIES
-    from .bench.tune import FreeParam, task_measure
-    from .bench.tune import tune as run_tune
-    from .control.params import CONTROLLERS, controller_from
-    from .engine.batch import BatchError
-    from .parameters import ParameterError
+    from ..bench.runner import STRATEGIES
+    from ..bench.tune import FreeParam, task_measure
+    from ..bench.tune import tune as run_tune
+    from ..control.params import CONTROLLERS, controller_from
+    from ..engine.batch import BatchError
+    from ..parameters import ParameterError
 
     if controller not in CONTROLLERS:
         _fail(f"controller {controller!r} is not one of {', '.join(CONTROLLERS)}")
@@ -153,14 +153,6 @@ def tune(
               f"{s['interlock_violations']} interlock violations")
     print("values: " + ", ".join(f"{k}={v:.6g}" for k, v in res.values.items()))
     if out is not None:
-        from .files import atomic_write_text
+        from ..files import atomic_write_text
 
         atomic_write_text(out, json.dumps(doc, indent=2, default=float) + "\n")
-
-
-app = typer.Typer(add_completion=False, help="Controller bench and tuning.")
-app.command("bench-controllers")(bench_controllers)
-app.command("tune")(tune)
-
-if __name__ == "__main__":  # pragma: no cover
-    app()
