@@ -17,6 +17,7 @@ from scipy.io import loadmat
 
 from smafinger import export
 from smafinger.cli import app, main
+from smafinger.engine.integrators import INTEGRATORS
 from smafinger.engine.signals import MECHANISM_FIELDS, WIRE_FIELDS
 
 QUICK = ["--profile", "0:-25", "--t-end", "1", "--no-progress"]
@@ -165,7 +166,7 @@ def test_mat_output_holds_every_signal_and_the_provenance(here, capsys):
 def test_help_lists_the_allowed_values(capsys):
     assert main(["simulate", "--help"]) == 0
     text = capsys.readouterr().out
-    assert "<open-loop|independent|cooperative>" in text and "<euler|rk4>" in text and "<str>" not in text
+    assert "<open-loop|independent|cooperative>" in text and f"<{'|'.join(INTEGRATORS)}>" in text and "<exact|averaged>" in text and "<str>" not in text
     assert main(["identify", "kinetics", "--help"]) == 0
     assert "<mean|row>" in capsys.readouterr().out
 

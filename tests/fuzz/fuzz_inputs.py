@@ -14,6 +14,8 @@ import random
 from hypothesis import strategies as st
 
 from fuzz_runner import Case
+from smafinger.engine.integrators import INTEGRATORS
+from smafinger.engine.pwm import PWM_MODELS
 from smafinger.parameters import MECHANISMS, get, names
 from smafinger.parameters.options import OPTION_NAMES
 
@@ -134,7 +136,8 @@ def simulate_cases(draw) -> Case:
     if "--t-end" not in argv and "--scenario" not in argv:
         argv.extend(["--t-end", repr(draw(st.floats(0.001, 3.0)))])  # keep the default 20 s for scenarios only
     maybe("--dt", DT, 0.3)
-    maybe("--method", mostly(st.sampled_from(["rk4", "euler"]), st.sampled_from(["RK4", "midpoint"])), 0.3)
+    maybe("--method", mostly(st.sampled_from(list(INTEGRATORS)), st.sampled_from(["RK4", "midpoint"])), 0.3)
+    maybe("--pwm", mostly(st.sampled_from(list(PWM_MODELS)), st.sampled_from(["Exact", "edges"])), 0.2)
     maybe("--output-interval", OUTPUT_INTERVAL, 0.3)
     maybe("--tol-deg", TOLERANCE, 0.15)
     maybe("--tol-m", TOLERANCE, 0.1)

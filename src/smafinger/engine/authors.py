@@ -11,12 +11,13 @@ the commands of its tick and only reads the PWM wave at the stage's phase.
 
 from typing import NamedTuple
 
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from ..control.controller import pid_commands
 from ..control.pid import on_time
 from ..control.strategies import Strategy
-from ..model.records import WireInput
+from ..model.records import Controller, WireInput
 from .clock import TICKS_PER_S
 from .pwm import sampled_drive
 from .tuples import set_item, with_field
@@ -34,6 +35,24 @@ class Stages(NamedTuple):
     phase_end: float  #: where in its period the PWM is read at h [s]
 
 
+def stage_commands(ctrl, model, enabled, q_target, y, cmds):
+    """The commands at a later stage: the paper's PID (Eq. 12a) re-evaluated at the stage's state
+    ``y``; any other controller keeps its tick's ``cmds`` (the authors' solver emulates their
+    PID only). Compiled code only: dispatched on the controller record's type."""
+    raise NotImplementedError("stage_commands() is compiled code: call it from a numba function")
+
+
+@overload(stage_commands)
+def _stage_commands(ctrl, model, enabled, q_target, y, cmds):
+    if isinstance(ctrl, types.BaseNamedTuple) and ctrl.instance_class is Controller:
+        def impl(ctrl, model, enabled, q_target, y, cmds):
+            return pid_commands(model, enabled, q_target, y, model.drive.V_H_V)[0]
+    else:
+        def impl(ctrl, model, enabled, q_target, y, cmds):
+            return cmds
+    return impl
+
+
 @njit(cache=True, inline="always")
 def stage_inputs(model, inputs, y, st, phase):
     """``inputs`` with each wire's drive and heating phase at stage state ``y``, ``phase`` s into the period.
@@ -45,7 +64,7 @@ def stage_inputs(model, inputs, y, st, phase):
     run = st.run
     cmds = st.cmds
     if run.strategy != Strategy.OPEN_LOOP and run.update_ticks == 0:
-        cmds, _ = pid_commands(model, st.enabled, st.q_target, y, model.drive.V_H_V)
+        cmds = stage_commands(model.controller, model, st.enabled, st.q_target, y, cmds)
     period = run.pwm_ticks / TICKS_PER_S
     wis = inputs.wires
     for i in range(len(wis)):
