@@ -106,9 +106,8 @@ HYSTERESIS = Study("hyst", _FIG12 + _FIG13 + _FIG15, (DEADBAND, FINE_STEP, ALGEB
 
 #: the paper2010 set's two C_DF values; its rule (heating-phase switching) is the scenarios' own runs
 C_DF = {"heating": P2010.C_DF_heating_Nms, "cooling": P2010.C_DF_cooling_Nms}
-#: one C_DF throughout, the heating or the cooling value (``damping_switch = heating-value`` is declared but
-#: the engine does not honour it yet: it switches as ``heating-phase`` does; the same physics is set here
-#: through the parameters, which does not depend on that)
+#: one C_DF throughout, the heating or the cooling value, set through the parameters (``damping_switch =
+#: heating-value`` gives the first of the two; tests/test_paper_claims.py checks they are the same run)
 ONE_CDF = {k: Overrides.of(**{f"C_DF_{'cooling' if k == 'heating' else 'heating'}_Nms": v}) for k, v in C_DF.items()}
 
 
