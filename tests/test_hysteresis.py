@@ -319,9 +319,15 @@ def ripple_cases(draw):
     lo, hi = m.M_F0_C - 10.0 + s0 / c, m.A_F0_C + 10.0 + s0 / c
     a, b = rng.uniform(lo, hi, 2)
     assume(abs(b - a) > 2 * abs(s1 - s0) / c + 1.0)  # both taus monotone along the ramp
+    d = draw(st.sampled_from([0.01, 0.1, 0.3, 1.0]))
+    # the start (xi = 1 heating, 0 cooling) on the major loop for the ramp and the rippled T alike: a
+    # start outside the loop is clamped at the first sample (tested on its own), whatever P5 says
+    if b > a:
+        assume(a + d < m.A_S0_C + s0 / m.c_A_Pa_per_C)
+    else:
+        assume(a - d > m.M_S0_C + s0 / m.c_M_Pa_per_C)
     n = draw(st.integers(50, 3000))
     periods = draw(st.floats(2.0, 500.0))  # the "PWM frequency"
-    d = draw(st.sampled_from([0.01, 0.1, 0.3, 1.0]))
     t = np.linspace(0.0, 1.0, n)
     ramp = a + (b - a) * t
     T = ramp + d * np.sin(2 * np.pi * periods * t + rng.uniform(0, 2 * np.pi))
