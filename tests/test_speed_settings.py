@@ -115,11 +115,12 @@ def test_reach_event_located_inside_the_step():
 
 
 def _authors_reference_times(n_steps, h, period):
-    """The authors' SMA1_Control_Signal.m, plain Python: (time - tRef) at each of ode4's stages."""
+    """The authors' SMA1_Control_Signal.m, plain Python: (time - tRef) at each of ode4's stages,
+    at Simulink's ode4 times (t = n h, t + 0.5 h, (n + 1) h)."""
     t_ref, out = 0.0, []
     for n in range(n_steps):
         phases = []
-        for t in (n * h, n * h + ((n + 1) * h - n * h) * 0.5, (n + 1) * h):
+        for t in (n * h, n * h + 0.5 * h, (n + 1) * h):
             if t - t_ref >= period:
                 t_ref = t
             phases.append(t - t_ref)
@@ -177,8 +178,9 @@ def _stage_drives(run, q_target_deg):
                                   method="authors-ode4"))["model"]
     y = initial_state(model)
     held = initial_commands(model)  # the tick's commands: every wire off
-    st = Stages(run, held, 0b11, math.radians(q_target_deg), 0.0, 0.0, 0.0)
-    inputs = stage_inputs(model, initial_inputs(model, False), y, st, 0.0)
+    q_target = math.radians(q_target_deg)
+    st = Stages(run, held, 0b11, q_target, 0.0, 0.0, 0.0, q_target - y.q)  # at rest since the major step
+    inputs = stage_inputs(model, initial_inputs(model, False), y, st, 0.0, 0.5e-3)
     return [(w.drive, w.heating) for w in inputs.wires], model.drive.V_H_V
 
 
@@ -199,3 +201,39 @@ def test_authors_stages_keep_the_ticks_commands_with_a_controller_period():
                                 method="authors-ode4"))["run"]
     held, _ = _stage_drives(run._replace(update_ticks=run.dt_ticks), -25.0)
     assert [d for d, _ in held] == [0.0, 0.0]
+
+
+def test_authors_pid_takes_its_error_rate_from_a_derivative_block():
+    """Their PID's d(theta_F - theta)/dt is a Simulink Derivative block (Finger_Full_Model.mdl,
+    SIDs 12 and 36): at a major step, the backward difference over the step just taken, not
+    -theta'. Checked on the recorded samples (one per 1 ms step) with K_I = 0, where the duty
+    is the PID's own output; the velocity's duty differs from it."""
+    p = get("authors2020").replace(K_I_per_rad_s=0.0)
+    r = simulate(p, "independent", "0:-25:upper", t_end_s=1.6, method="authors-ode4")
+    assert np.allclose(np.diff(r.t_s), 1e-3)
+    e = np.radians(r.theta_ref_deg - r.theta_deg)
+    block = np.clip(p.K_P_per_rad * e[1:] + p.K_V_s_per_rad * np.diff(e) / 1e-3, 0.0, 100.0)
+    velocity = np.clip(p.K_P_per_rad * e[1:] - p.K_V_s_per_rad * np.radians(r.omega_deg_s[1:]), 0.0, 100.0)
+    duty, heating = r.duty_upper[1:], r.heating_upper[1:] > 0
+    between = heating & (duty > 0.0) & (duty < 100.0)
+    assert between.sum() > 100
+    assert np.abs(duty - block)[heating].max() < 1e-6
+    assert np.abs(duty - velocity)[between].max() > 0.5
+
+
+def test_authors_stages_take_the_error_rate_since_the_major_step():
+    """At a later stage the Derivative block divides the error's change since the major step by
+    the time since it: an error shrinking by 1e-5 rad in 0.5 ms (-0.02 rad/s, -100 % through
+    K_V = 5000) turns off a wire that a 1e-4 rad error alone turns on (the joint at rest)."""
+    from smafinger.engine.authors import Stages, stage_inputs
+    from smafinger.engine.substep import initial_commands, initial_inputs, initial_state
+
+    args = kernel_args(make_spec("authors2020", "independent", "0:-25:upper", t_end_s=1.0, method="authors-ode4"))
+    model, run = args["model"], args["run"]
+    y = initial_state(model)
+    q_target = y.q + 1e-4
+    drives = []
+    for shrunk in (0.0, 1e-5):
+        st = Stages(run, initial_commands(model), 0b01, q_target, 0.0, 0.0, 0.0, q_target - y.q + shrunk)
+        drives.append(stage_inputs(model, initial_inputs(model, False), y, st, 0.0, 0.5e-3).wires[0].drive)
+    assert drives == [model.drive.V_H_V, 0.0]

@@ -1,12 +1,25 @@
-"""The authors' Simulink solver (``authors-ode4``): what each stage of their ode4 sees.
+"""The authors' Simulink solver (``authors-ode4``): what each evaluation of their model sees.
 
-In the authors' model (MODEL-NOTES, "Details of the authors' 2020 model") the control block is
-evaluated at every solver evaluation: at each of ode4's four stages the PID (Eq. 12a) is
-computed from that stage's state, the phase chosen (Sec. 2.6) and the PWM wave read at the
-stage's time (:func:`.pwm.sampled_phases`). :func:`stage_inputs` builds those held inputs.
-Their controller's sampling times are 0 (``dtCtrl_H = dtCtrl_C = 0``, ``Initialization.m``), so
-it is re-evaluated at every call; a run with a controller period, or an open-loop program, keeps
-the commands of its tick and only reads the PWM wave at the stage's phase.
+Their model (``Code/Finger_Full_Model.mdl`` in gabrielegilardi/FingerControl; MODEL-NOTES,
+"Details of the authors' 2020 model") is solved by ode4 at a fixed 1 ms step (its
+``Simulink.SolverCC``: ``Solver "ode4"``, ``FixedStep "0.001"``). ode4 evaluates the model's
+outputs at the major time t_n and at its three later stages, t_n + h/2 (twice) and t_n + h,
+and each of these evaluations runs the control blocks:
+
+- the PID (Eq. 12a) in the MATLAB function ``SMA1_Control_Signal.m`` / ``SMA2_Control_Signal.m``
+  (``MATLABFcn`` blocks "SMA1 Control Signal" / "Control Signal 2", no sample time set: they
+  inherit the continuous rate of their inputs), re-evaluated at every call since their
+  sampling times are 0 (``dtCtrl_H = dtCtrl_C = 0``, ``Initialization.m``);
+- its error rate d(theta_F - theta)/dt from a Simulink ``Derivative`` block ("SMA1 Controller"
+  / "SMA2 Controller", SIDs 12 and 36), not from the joint's velocity: the block divides the
+  change of its input since the last *major* step by the time since it
+  (:func:`derivative_block`), so at t_n it is the backward difference over the step just
+  taken, at the stages the difference from t_n;
+- the PWM wave read at the call's time (:func:`.pwm.sampled_phases`).
+
+:func:`stage_inputs` builds a later stage's inputs; :func:`major_commands` the major step's.
+A run with a controller period, or an open-loop program, keeps the commands of its tick at the
+stages and only reads the PWM wave at the stage's phase.
 """
 
 from typing import NamedTuple
@@ -14,8 +27,8 @@ from typing import NamedTuple
 from numba import njit, types
 from numba.extending import overload
 
-from ..control.controller import pid_commands
-from ..control.pid import on_time
+from ..control.controller import integrating_flag, phase_commands
+from ..control.pid import on_time, pid_output
 from ..control.strategies import Strategy
 from ..model.records import Controller, WireInput
 from .clock import TICKS_PER_S
@@ -33,38 +46,83 @@ class Stages(NamedTuple):
     low: float  #: the PWM's low level (V_L, or 0 A with a current drive)
     phase_mid: float  #: where in its period the PWM is read at h/2 [s]
     phase_end: float  #: where in its period the PWM is read at h [s]
+    error_major: float  #: the Derivative block's input at the step's major time, q_F - q [rad or m]
 
 
-def stage_commands(ctrl, model, enabled, q_target, y, cmds):
-    """The commands at a later stage: the paper's PID (Eq. 12a) re-evaluated at the stage's state
-    ``y``; any other controller keeps its tick's ``cmds`` (the authors' solver emulates their
-    PID only). Compiled code only: dispatched on the controller record's type."""
-    raise NotImplementedError("stage_commands() is compiled code: call it from a numba function")
+class DerivativeMemory(NamedTuple):
+    """What a Simulink Derivative block keeps: its input at the last major step."""
+
+    error: float  #: the input (q_F - q) [rad or m]
+    tick: int  #: when (-1: no major step yet)
 
 
-@overload(stage_commands)
-def _stage_commands(ctrl, model, enabled, q_target, y, cmds):
+#: before the first major step
+NO_MAJOR_STEP = DerivativeMemory(0.0, -1)
+
+
+@njit(cache=True, inline="always")
+def derivative_block(error, error_last, dt):
+    """A Simulink ``Derivative`` block's output: (u - u_last) / (t - t_last).
+
+    ``error_last`` is the input at the last major step, ``dt`` [s] the time since it; 0 when
+    there is none (``dt <= 0``; the block's initial output is 0). As Simulink implements the
+    block: two (time, input) pairs written at major steps only (``TimeStampA/B``,
+    ``LastUAtTimeA/B``), the output taken against the latest one before the current time,
+    whether that is a major or a minor (stage) time.
+    """
+    if dt <= 0.0:
+        return 0.0
+    return (error - error_last) / dt
+
+
+def pid_at_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
+    """(commands, integrating): the paper's PID (Eq. 12a) at state ``y`` with the error rate
+    ``error_rate`` (their Derivative block's) in place of -q'; any other controller keeps
+    ``cmds`` (the authors' solver emulates their PID only). Compiled code only: dispatched on
+    the controller record's type."""
+    raise NotImplementedError("pid_at_rate() is compiled code: call it from a numba function")
+
+
+@overload(pid_at_rate)
+def _pid_at_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
     if isinstance(ctrl, types.BaseNamedTuple) and ctrl.instance_class is Controller:
-        def impl(ctrl, model, enabled, q_target, y, cmds):
-            return pid_commands(model, enabled, q_target, y, model.drive.V_H_V)[0]
+        def impl(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
+            e = q_target - y.q
+            u = pid_output(e, error_rate, y.error_integral, ctrl.K_P, ctrl.K_V, ctrl.K_I)
+            return (phase_commands(model, enabled, u, q_target, y.q, model.drive.V_H_V),
+                    integrating_flag(model, u, e))
     else:
-        def impl(ctrl, model, enabled, q_target, y, cmds):
-            return cmds
+        def impl(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
+            return cmds, integrating
     return impl
 
 
 @njit(cache=True, inline="always")
-def stage_inputs(model, inputs, y, st, phase):
-    """``inputs`` with each wire's drive and heating phase at stage state ``y``, ``phase`` s into the period.
+def major_commands(model, run, t, s, y, cmds, integrating, memory):
+    """(commands, integrating) at a control tick ``t`` (a major step): the PID's with the error
+    rate of the Derivative block (:func:`derivative_block`) against the previous major step
+    ``memory``, in place of the tick's ``cmds`` (closed loop only)."""
+    if run.strategy == Strategy.OPEN_LOOP:
+        return cmds, integrating
+    dt = (t - memory.tick) * run.tick_s if memory.tick >= 0 else 0.0
+    rate = derivative_block(s.q_target - y.q, memory.error, dt)
+    return pid_at_rate(model.controller, model, s.enabled, s.q_target, y, cmds, integrating, rate)
+
+
+@njit(cache=True, inline="always")
+def stage_inputs(model, inputs, y, st, phase, since):
+    """``inputs`` with each wire's drive and heating phase at stage state ``y``, ``since`` s
+    after the major step, ``phase`` s into the PWM period.
 
     Closed loop with a controller evaluated continuously (``run.update_ticks == 0``): the
-    commands from the PID (Eq. 12a) at ``y`` (the drive and the heating phase); otherwise the
-    tick's ``cmds``.
+    commands from the PID (Eq. 12a) at ``y`` with the Derivative block's error rate against
+    the major step; otherwise the tick's ``cmds``.
     """
     run = st.run
     cmds = st.cmds
     if run.strategy != Strategy.OPEN_LOOP and run.update_ticks == 0:
-        cmds = stage_commands(model.controller, model, st.enabled, st.q_target, y, cmds)
+        rate = derivative_block(st.q_target - y.q, st.error_major, since)
+        cmds = pid_at_rate(model.controller, model, st.enabled, st.q_target, y, cmds, 1.0, rate)[0]
     period = run.pwm_ticks / TICKS_PER_S
     wis = inputs.wires
     for i in range(len(wis)):

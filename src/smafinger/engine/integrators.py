@@ -12,11 +12,12 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
 - ``exponential``: exponential Euler for the mechanism: (q, v) advanced exactly under the held
   load with the damping C_DF (phi functions), the wires by Euler. Like ``semi-implicit`` but
   exact for the damped motion under a constant load.
-- ``authors-ode4``: the authors' Simulink solver (classical RK4 at a fixed step, MODEL-NOTES)
-  with the PWM read at the stage times (:mod:`.pwm`, ``sampled``) and the controller
-  re-evaluated at every stage (:mod:`.authors`), as their model does. Not yet enough to
-  reproduce their published temperatures: profile 2's lower-wire peak is 155.7 degC with it,
-  123.6 degC with the resolved PWM, 135 degC in their plots (docs/speed.md).
+- ``authors-ode4``: the authors' Simulink solver (ode4, classical RK4 at a fixed 1 ms step,
+  MODEL-NOTES) with the PWM read at its stage times (:mod:`.pwm`, ``sampled``), the controller
+  re-evaluated at every stage and its error rate from their Derivative block (:mod:`.authors`),
+  as their model does. Not enough to reproduce their published temperatures: profile 2's
+  lower-wire peak is 151.6 degC with it, 123.6 degC with the resolved PWM, 135 degC in their
+  plots (docs/speed.md).
 """
 
 from __future__ import annotations
@@ -139,7 +140,8 @@ def step(method, model, y, h, inputs, k1, geom, stages):
         q_prev = yk.q
         inp = inputs
         if method == Method.AUTHORS_ODE4:
-            inp = stage_inputs(model, inputs, yk, stages, stages.phase_end if stage == 2 else stages.phase_mid)
+            since = h if stage == 2 else half
+            inp = stage_inputs(model, inputs, yk, stages, stages.phase_end if stage == 2 else stages.phase_mid, since)
         k = derivative(yk, inp, model, g)[0]
         acc = axpy(acc, 1.0 if stage == 2 else 2.0, k)
     return axpy(y, h / 6.0, acc), 3

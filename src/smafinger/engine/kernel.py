@@ -24,6 +24,7 @@ from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
 from ..model.hysteresis_memory import STACK_COLUMNS
 from ..parameters.options import IntegralReset
+from .authors import NO_MAJOR_STEP, DerivativeMemory, major_commands
 from .dense import interpolated, zero_aux
 from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
@@ -167,6 +168,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1, geom)
     integrating = 1.0
     pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)
+    memory = NO_MAJOR_STEP  #: the authors' Derivative block's last major step (authors.major_commands)
     locate = run.pwm == PwmModel.AVERAGED  #: long steps: reach events located inside a step
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
@@ -190,6 +192,10 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
             cmds, integrating, ctl = control_tick(model.controller, ctl, model, s, y, inputs, geom, geom_q,
                                                   t * run.tick_s, started)
+            if run.pwm == PwmModel.SAMPLED:  # the authors' solver: their PID's error rate
+                cmds, integrating = major_commands(model, run, t, s, y, cmds, integrating, memory)
+        if run.pwm == PwmModel.SAMPLED:  # their Derivative block's update, after its output
+            memory = DerivativeMemory(s.q_target - y.q, t)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
         event = next_event
         if locate:  # long steps: one ends where the target will count as reached
@@ -215,7 +221,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
                 out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
             y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
-                                            phase_mid, phase_end)
+                                            phase_mid, phase_end, memory.error)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b

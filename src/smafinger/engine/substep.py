@@ -210,16 +210,16 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, inline="always")
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end):
+def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end, error_major):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 
     With the authors' solver the later stages read the controller and the PWM at their own
     states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
-    schedule; see :func:`.authors.stage_inputs`). Returns (y, counters,
+    schedule, ``error_major``: q_F - q at the major step; see :func:`.authors.stage_inputs`). Returns (y, counters,
     t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
     """
     if b > a:
-        stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end)
+        stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end, error_major)
         y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
