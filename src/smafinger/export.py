@@ -21,6 +21,7 @@ all of its outputs or none. Every output says how it was made
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from .files import Outputs, OutputError, json_ready, json_text
@@ -34,6 +35,8 @@ PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 PARQUET_KEY = b"smafinger.provenance"
 #: CSV float format (9 significant digits: a 1 ns step at 1000 s, 1e-9 relative elsewhere)
 CSV_FLOAT_FORMAT = "%.9g"
+#: rows formatted and written at a time by :func:`write_signals_csv`
+CSV_CHUNK_ROWS = 8192
 
 
 def sidecar_path(csv_path: str | Path) -> Path:
@@ -54,8 +57,9 @@ def add_signals(outputs: Outputs, result, path: str | Path, what: str = "--out",
     fmt = SIGNAL_FORMATS[check_suffix(path, SIGNAL_FORMATS, what)]
     prov = provenance(result.spec, **extra)
     if fmt == "csv":
-        df = result.to_pandas()
-        outputs.add(path, lambda tmp: df.to_csv(tmp, index=False, float_format=CSV_FLOAT_FORMAT), what)
+        names = list(result.column_names)
+        columns = [result.signal(n) for n in names]
+        outputs.add(path, lambda tmp: write_signals_csv(tmp, names, columns), what)
         text = json_text(prov, digits=None)
         outputs.add(sidecar_path(path), lambda tmp: Path(tmp).write_text(text), f"{what} (provenance sidecar)")
     elif fmt == "parquet":
@@ -66,6 +70,43 @@ def add_signals(outputs: Outputs, result, path: str | Path, what: str = "--out",
         names = [n for n in result.column_names if n != "t_s"]
         mdict, _ = mat_variables(result.t, {n: result.signal(n) for n in names}, _for_matlab(prov))
         outputs.add(path, lambda tmp: save_mat(tmp, mdict), what)
+
+
+def write_signals_csv(path: str | Path, names: list[str], columns: list) -> None:
+    """The columns as CSV, byte for byte what ``pandas.DataFrame.to_csv(index=False,
+    float_format=CSV_FLOAT_FORMAT)`` writes, about 3x faster and without importing pandas.
+
+    The fast path formats a whole row with one ``%`` (C code) and covers what runs produce:
+    float64 columns of finite values under plain names. Anything else (NaN, which pandas
+    writes as an empty field; other dtypes; names that need quoting) goes through pandas.
+    """
+    import numpy as np
+
+    if not _plain_csv(names, columns):
+        import pandas as pd
+
+        pd.DataFrame(dict(zip(names, columns))).to_csv(path, index=False, float_format=CSV_FLOAT_FORMAT)
+        return
+    data = np.column_stack(columns)
+    row = ",".join([CSV_FLOAT_FORMAT] * len(names))
+    eol = os.linesep
+    with open(path, "w", encoding="utf-8", newline="") as f:
+        f.write(",".join(names) + eol)
+        for start in range(0, len(data), CSV_CHUNK_ROWS):
+            f.write("".join([row % tuple(r) + eol for r in data[start:start + CSV_CHUNK_ROWS].tolist()]))
+
+
+def _plain_csv(names: list[str], columns: list) -> bool:
+    """Whether :func:`write_signals_csv`'s fast path writes what pandas would: unique names
+    needing no quotes, float64 columns of equal length, every value finite."""
+    import numpy as np
+
+    if not columns or len(set(names)) != len(names) or len(names) != len(columns):
+        return False
+    if not all(n and n == n.strip() and not any(c in n for c in ',"\r\n') for n in names):
+        return False
+    return all(isinstance(c, np.ndarray) and c.dtype == np.float64 and c.ndim == 1 and len(c) == len(columns[0])
+               and np.isfinite(c).all() for c in columns)
 
 
 def _parquet_writer(result, prov: dict):

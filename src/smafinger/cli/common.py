@@ -8,17 +8,15 @@ from typing import Literal
 
 import typer
 
-from ..control.strategies import STRATEGIES
-from ..engine.integrators import INTEGRATORS
-from ..engine.pwm import PWM_MODELS
 from ..progress import Display
+from .choices import METHOD_NAMES, PWM_NAMES, STRATEGY_NAMES
 from .errors import UsageError, reading_input
 
 #: ``--strategy`` values (``--help`` lists them)
-Strategy = Literal[tuple(STRATEGIES)]
+Strategy = Literal[STRATEGY_NAMES]
 #: ``--method`` values
-Method = Literal[tuple(INTEGRATORS)]
-Pwm = Literal[tuple(PWM_MODELS)]
+Method = Literal[METHOD_NAMES]
+Pwm = Literal[PWM_NAMES]
 
 
 def given(ctx: typer.Context, *names: str) -> list[str]:

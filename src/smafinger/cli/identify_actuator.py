@@ -22,22 +22,9 @@ from typing import Callable, List, Optional
 
 import typer
 
-from ..analysis import actuator_report as ar
-from ..analysis.actuator_fit import FitError, FitSettings, fit_actuator
-from ..analysis.bench_runs import RigController, load_closed_loop, load_open_loop
-from ..analysis.data import parameter_file_text
-from ..analysis.free_params import FreeBox, parse_free
-from ..engine.batch import make_pool
-from ..engine.pools import BatchError
-from ..engine.run import SimulationError
-from ..files import temp_path
-from ..parameters import REGISTRY, ParameterError, resolve
-from ..profiles import ProfileError
-from ..recordings import RecordingError, parse_map_options
+from .choices import FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 
 CMD = "smafinger identify actuator"
-_DEFAULTS = FitSettings()
-_USAGE = (RecordingError, ParameterError, ProfileError, ValueError)
 #: warn when the fitted runs' RMS exceeds the baseline noise by this factor
 MISFIT_WARN = 1.5
 #: separates a run's file from its own mapping: RUN.mat::duty=u,position_m=x_mm*1e-3
@@ -66,9 +53,9 @@ def actuator(
     free: Optional[List[str]] = typer.Option(None, "--free", metavar="NAME[:LO:HI]", help="a field to fit, with bounds; A+B ties fields (repeatable; default per mechanism)"),
     wire: Optional[str] = typer.Option(None, "--wire", metavar="NAME", help="the wire the recorded input drives (default: the first)"),
     offset: str = typer.Option("per-run", "--offset", metavar="per-run|none", help="a sensor offset per run (fitted, or measured before the drive on held-out runs), or none"),
-    budget: int = typer.Option(_DEFAULTS.budget, "--budget", metavar="N", help="candidate sets the global stage (CMA-ES) may try; 0 skips it"),
-    max_nfev: int = typer.Option(_DEFAULTS.max_nfev, "--max-nfev", metavar="N", help="iterations of the least-squares stage"),
-    seed: int = typer.Option(_DEFAULTS.seed, "--seed", metavar="N", help="seed of the global stage"),
+    budget: int = typer.Option(FIT_BUDGET, "--budget", metavar="N", help="candidate sets the global stage (CMA-ES) may try; 0 skips it"),
+    max_nfev: int = typer.Option(FIT_MAX_NFEV, "--max-nfev", metavar="N", help="iterations of the least-squares stage"),
+    seed: int = typer.Option(FIT_SEED, "--seed", metavar="N", help="seed of the global stage"),
     workers: Optional[int] = typer.Option(None, "--workers", metavar="N", help="worker processes (default: every core; 1: this process)"),
     out: Optional[Path] = typer.Option(None, "--out", metavar="FIT.toml", help="fitted parameter file (needs --fit)"),
     report: Optional[Path] = typer.Option(None, "--report", metavar="REPORT.json", help="JSON report"),
@@ -76,11 +63,18 @@ def actuator(
     progress: Optional[bool] = typer.Option(None, "--progress/--no-progress", help="simulation count on stderr (default: on a terminal)"),
 ):
     """Fit an SMA actuator's parameters to bench runs at once; predict held-out and closed-loop runs."""
+    from ..analysis.actuator_fit import FitError
+    from ..engine.pools import BatchError
+    from ..engine.run import SimulationError
+    from ..parameters import ParameterError
+    from ..profiles import ProfileError
+    from ..recordings import RecordingError
+
     t0 = time.perf_counter()
     try:
         setup = _setup(params, set_ or [], fit or [], validate or [], replay or [], map_ or [], reference, gains,
                        duty_max, free or [], wire, offset, budget, max_nfev, seed, workers, out, report, plot)
-    except (Usage, *_USAGE) as exc:
+    except (Usage, RecordingError, ParameterError, ProfileError, ValueError) as exc:
         _fail(str(exc), 2)
     try:
         result = _compute(setup, _use_progress(progress))
@@ -99,6 +93,13 @@ def actuator(
 def _setup(params, overrides, fit, validate, replay, maps, reference, gains, duty_max, free, wire, offset, budget,
            max_nfev, seed, workers, out, report, plot) -> dict:
     """Everything checked before any simulation: options, outputs, the set, the runs."""
+    from ..analysis import actuator_report as ar
+    from ..analysis.actuator_fit import FitSettings
+    from ..analysis.bench_runs import load_closed_loop, load_open_loop
+    from ..analysis.free_params import FreeBox, parse_free
+    from ..parameters import REGISTRY, resolve
+    from ..recordings import parse_map_options
+
     if not (fit or validate or replay):
         raise Usage("no run given: use --fit, --validate or --replay RUN (repeatable)")
     if offset not in ar.OFFSET_POLICIES:
@@ -144,6 +145,8 @@ def _split_run(arg: str) -> tuple[str, list[str]]:
 
 def _run_map(arg: str, maps: list[str]):
     """(file, mapping): the run's own ``::`` entries override ``--map`` entries of the same signal."""
+    from ..recordings import parse_map_options
+
     path, own = _split_run(arg)
     names = {m.partition("=")[0].strip() for m in own}
     return path, parse_map_options([m for m in maps if m.partition("=")[0].strip() not in names] + own)
@@ -161,6 +164,8 @@ def _check_path(opt: str, path: Optional[Path], suffixes: tuple[str, ...]) -> No
 
 
 def _controller(gains: Optional[str], duty_max: float) -> RigController:
+    from ..analysis.bench_runs import RigController
+
     if gains is None:
         return RigController(duty_max=duty_max)
     parts = gains.split(":")
@@ -182,6 +187,10 @@ def _compute(setup: dict, show: bool) -> dict:
     from rich.console import Console
     from rich.progress import Progress, TextColumn, TimeElapsedColumn
 
+    from ..analysis import actuator_report as ar
+    from ..analysis.actuator_fit import fit_actuator
+    from ..engine.batch import make_pool
+
     runs, box, s = setup["runs"], setup["box"], setup["settings"]
     fit_runs = [r for r in runs if r.role == "fit"]
     bar = Progress(TextColumn("{task.description}"), TimeElapsedColumn(), console=Console(stderr=True),
@@ -201,6 +210,10 @@ def _compute(setup: dict, show: bool) -> dict:
 
 def _outputs(setup: dict, result: dict, wall_s: float) -> tuple[list[tuple[Path, Callable[[str], None]]], dict]:
     """(path, writer) of every output, and the report."""
+    from ..analysis import actuator_report as ar
+    from ..analysis.data import parameter_file_text
+    from ..parameters import ParameterError
+
     p, fit, preds = result["p"], result["fit"], result["predictions"]
     names = ar.figure_names(preds)
     plot = setup["plot"]
@@ -232,6 +245,8 @@ def _figure_writer(pr, p) -> Callable[[str], None]:
     def write(tmp: str) -> None:
         import matplotlib.pyplot as plt
 
+        from ..analysis import actuator_report as ar
+
         fig = ar.run_figure(pr, p)
         try:
             fig.savefig(tmp, dpi=110, format="png")
@@ -243,6 +258,8 @@ def _figure_writer(pr, p) -> Callable[[str], None]:
 
 def _commit(outputs: list[tuple[Path, Callable[[str], None]]], plot: Optional[Path]) -> None:
     """Write every output to a temporary file beside it, then rename all into place."""
+    from ..files import temp_path
+
     made_dir = plot is not None and not plot.exists()
     if made_dir:
         plot.mkdir()
@@ -263,6 +280,8 @@ def _commit(outputs: list[tuple[Path, Callable[[str], None]]], plot: Optional[Pa
 
 
 def _print(setup: dict, result: dict) -> None:
+    from ..analysis import actuator_report as ar
+
     p, fit, preds = result["p"], result["fit"], result["predictions"]
     factor, unit, _ = ar.DISPLAY[ar.output_si_name(p)]
     if fit is not None:

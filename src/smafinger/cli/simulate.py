@@ -7,7 +7,7 @@ from typing import List, Optional
 
 import typer
 
-from ..engine.run import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M
+from .choices import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M
 from .common import Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
