@@ -17,6 +17,8 @@ from smafinger.cli import choices
 #: Arrow) and the package's own numerical layers; none is needed to print help
 HEAVY = ("numba", "llvmlite", "scipy", "pandas", "matplotlib", "dask", "pyarrow", "smafinger.engine",
          "smafinger.model", "smafinger.control", "smafinger.analysis")
+#: the engine's plain defaults (engine/defaults.py: no numba), which help shows
+LIGHT = ("smafinger.engine", "smafinger.engine.defaults")
 
 PROBE = """
 import json, sys
@@ -37,7 +39,8 @@ def _modules_after(code: str, *args: str) -> dict:
 
 
 def _heavy(modules: list[str]) -> list[str]:
-    return [m for m in modules if m.split(".")[0] in HEAVY or any(m == h or m.startswith(h + ".") for h in HEAVY)]
+    return [m for m in modules if m not in LIGHT
+            and (m.split(".")[0] in HEAVY or any(m == h or m.startswith(h + ".") for h in HEAVY))]
 
 
 @pytest.mark.parametrize("argv", [["--help"], [], ["simulate", "--help"], ["identify", "--help"],
@@ -85,7 +88,7 @@ def test_choices_are_the_engines():
     assert choices.METHOD_NAMES == tuple(INTEGRATORS)
     assert choices.PWM_NAMES == tuple(PWM_MODELS)
     for name in ("DEFAULT_DT_S", "DEFAULT_METHOD", "DEFAULT_OUTPUT_S", "DEFAULT_PWM", "DEFAULT_TOL_M"):
-        assert getattr(choices, name) == getattr(run, name), name
+        assert getattr(choices, name) is getattr(run, name), name
 
 
 def test_fit_defaults_are_fit_settings():

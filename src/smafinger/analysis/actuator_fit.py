@@ -28,7 +28,7 @@ from typing import Callable, Sequence
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..engine.run import DEFAULT_DT_S
+from ..engine.defaults import DEFAULT_DT_S, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 from ..parameters import ParameterSet
 from .actuator_eval import Evaluator
 from .bench_runs import BenchRun
@@ -77,11 +77,11 @@ class FitSettings:
         Fit a sensor offset per run (profiled out), or take the output as calibrated.
     """
 
-    budget: int = 1500
+    budget: int = FIT_BUDGET
     popsize: int | None = None
     sigma0: float = 0.25
-    seed: int = 1
-    max_nfev: int = 40
+    seed: int = FIT_SEED
+    max_nfev: int = FIT_MAX_NFEV
     diff_step: float = 1e-2
     dt_s: float = DEFAULT_DT_S
     fit_offsets: bool = True

@@ -1,13 +1,17 @@
 """The choices and defaults the commands' options show in ``--help``, without loading the engine.
 
-The engine defines these (``control.strategies.STRATEGIES``, ``engine.integrators.INTEGRATORS``,
-``engine.pwm.PWM_MODELS``, ``engine.run.DEFAULT_*``, ``analysis.actuator_fit.FitSettings``), but
-importing it loads numba and the compiled kernel: about a second before ``smafinger --help``
-could print. They are repeated here as plain values; ``tests/test_cli_startup.py`` checks that
-they equal the engine's, so a change there fails the tests instead of drifting.
+The defaults come from :mod:`smafinger.engine.defaults` (plain values, one copy). The names of
+the choices are declared by the modules that implement them (``control.strategies.STRATEGIES``,
+``engine.integrators.INTEGRATORS``, ``engine.pwm.PWM_MODELS``), which load numba: about a second
+before ``smafinger --help`` could print. They are listed here as plain names;
+``tests/test_cli_startup.py`` checks that they equal the engine's.
 """
 
 from __future__ import annotations
+
+# the engine's defaults and identification's: one copy, in a module that loads no numba
+from ..engine.defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM,  # noqa: F401
+                               DEFAULT_TOL_M, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED)
 
 #: control strategies (``control.strategies.STRATEGIES``)
 STRATEGY_NAMES = ("open-loop", "independent", "cooperative")
@@ -15,15 +19,3 @@ STRATEGY_NAMES = ("open-loop", "independent", "cooperative")
 METHOD_NAMES = ("euler", "rk4", "semi-implicit", "exponential", "authors-ode4")
 #: PWM models a user chooses (``engine.pwm.PWM_MODELS``)
 PWM_NAMES = ("exact", "averaged")
-
-#: ``engine.run``'s defaults: step [s], integrator, output sampling [s], PWM model, linear tolerance [m]
-DEFAULT_DT_S = 1e-3
-DEFAULT_METHOD = "rk4"
-DEFAULT_OUTPUT_S = 1e-3
-DEFAULT_PWM = "exact"
-DEFAULT_TOL_M = 5e-4
-
-#: ``analysis.actuator_fit.FitSettings()``: global-stage budget, least-squares iterations, seed
-FIT_BUDGET = 1500
-FIT_MAX_NFEV = 40
-FIT_SEED = 1

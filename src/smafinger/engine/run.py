@@ -23,18 +23,9 @@ from . import integrators, pwm as pwm_models
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
+from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M  # noqa: F401
 from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
 
-DEFAULT_DT_S = 1e-3
-#: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
-#: 0.01 deg RMS from a 1 us reference there (benchmarks/bench_core.py), but it blows up on
-#: the open-loop Table II runs of Figs. 7-8 (a stiff joint-tendon mode): not a safe default.
-DEFAULT_METHOD = "rk4"
-DEFAULT_OUTPUT_S = 1e-3
-#: the PWM resolved at its edges (engine.pwm); "averaged" allows long steps (docs/speed.md)
-DEFAULT_PWM = "exact"
-#: default target tolerance of the linear actuator [m]
-DEFAULT_TOL_M = 5e-4
 
 
 class SimulationError(RuntimeError):

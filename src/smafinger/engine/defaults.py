@@ -1,0 +1,23 @@
+"""The engine's defaults, as plain values (importing this loads no numba: ``--help`` shows them).
+
+:mod:`.run` and the commands (:mod:`smafinger.cli`) both read them from here.
+"""
+
+#: integration step [s]
+DEFAULT_DT_S = 1e-3
+#: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
+#: 0.01 deg RMS from a 1 us reference there (benchmarks/bench_core.py), but it blows up on
+#: the open-loop Table II runs of Figs. 7-8 (a stiff joint-tendon mode): not a safe default.
+DEFAULT_METHOD = "rk4"
+#: output sampling [s]
+DEFAULT_OUTPUT_S = 1e-3
+#: the PWM resolved at its edges (engine.pwm); "averaged" allows long steps (docs/speed.md)
+DEFAULT_PWM = "exact"
+#: default target tolerance of the linear actuator [m]
+DEFAULT_TOL_M = 5e-4
+
+#: identification's two stages (analysis.actuator_fit.FitSettings): the global stage's budget
+#: of candidate sets, the least-squares stage's iterations, CMA-ES's seed
+FIT_BUDGET = 1500
+FIT_MAX_NFEV = 40
+FIT_SEED = 1
