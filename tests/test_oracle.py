@@ -64,7 +64,7 @@ def engine_values(p, s: Vars, u: Held) -> dict[str, float]:
     """The compiled derivative and outputs at the oracle's state and inputs, by the oracle's names."""
     model = build_model(p)
     state = State(s.q, s.v, s.error_integral,
-                  tuple(WireState(w.T, w.sigma, w.electrical, w.heat, w.T_case) for w in s.wires))
+                  tuple(WireState(w.T, w.sigma, w.electrical, w.heat, w.T_case, 0.0) for w in s.wires))
     inputs = Inputs(u.stuck, u.viscous, u.q_target, u.integrating, u.current, tuple(
         WireInput(w.drive, w.heating, engine_branch(w.branch, p, s.wires[i].T), 0) for i, w in enumerate(u.wires)))
     rate, aux = derivative(state, inputs, model, geometry(model, s.q))

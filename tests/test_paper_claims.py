@@ -123,15 +123,7 @@ def test_fig15_on_reach_cycle_time_is_the_sum_of_reached_s(runs, name):
     assert run.derived["elapsed_s"] == pytest.approx(run.derived["cycle_s"] + (n - 1) * run.spec.hold_s, abs=1e-6)
 
 
-#: Fig. 15 runs that do not reach every target at the scenarios' 1 ms step (report.md, issue 10's section:
-#: after a full transformation the rate-form stress law leaves the joint 1-2.6 deg off -40 deg, where the
-#: returns creep on the integral term; at 0.1 ms they reach it)
-RETURN_GAP_AT_1MS = {"fig15-independent-v2", "fig15-independent-scheduled-v2", "fig15-independent-scheduled-v1"}
-
-
-@pytest.mark.parametrize("name", [pytest.param(n, marks=[pytest.mark.xfail(
-    strict=True, reason="the return to -40 deg is not reached at 1 ms (rate-law drift)")] if n in RETURN_GAP_AT_1MS else [])
-    for n in scenarios.names() if n.startswith("fig15-")])
+@pytest.mark.parametrize("name", [n for n in scenarios.names() if n.startswith("fig15-")])
 def test_fig15_cycles_visit_every_target(runs, name):
     segs = runs[name].summary["segments"]
     assert [s["target_deg"] for s in segs][-1] == -40.0

@@ -29,7 +29,8 @@ def _mix(a, b, w):
 @njit(cache=True)
 def _wire_state(a, b, w):
     return WireState(_mix(a.T_C, b.T_C, w), _mix(a.sigma_Pa, b.sigma_Pa, w), _mix(a.electrical_J, b.electrical_J, w),
-                     _mix(a.heat_J, b.heat_J, w), _mix(a.T_case_C, b.T_case_C, w))
+                     _mix(a.heat_J, b.heat_J, w), _mix(a.T_case_C, b.T_case_C, w),
+                     _mix(a.xi_integrated, b.xi_integrated, w))
 
 
 @njit(cache=True)

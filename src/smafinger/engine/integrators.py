@@ -70,7 +70,7 @@ def get(name: str) -> Integrator:
 @njit(cache=True)
 def _wire_axpy(a, c, b):
     return WireState(a.T_C + c * b.T_C, a.sigma_Pa + c * b.sigma_Pa, a.electrical_J + c * b.electrical_J,
-                     a.heat_J + c * b.heat_J, a.T_case_C + c * b.T_case_C)
+                     a.heat_J + c * b.heat_J, a.T_case_C + c * b.T_case_C, a.xi_integrated + c * b.xi_integrated)
 
 
 @njit(cache=True, inline="always")

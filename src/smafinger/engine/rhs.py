@@ -54,9 +54,9 @@ def _wire_terms(model, state, inputs, geom, i):
     wi = inputs.wires[i]
     rt = geom.routes[i]
     opts = model.options
-    dT, dsigma, dTc, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, opts)
+    dT, dsigma, dTc, dxi, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, opts)
     heat = joule_power_per_m(wire, wi.drive, inputs.current_drive, opts.joule_heating) * wire.wire_length_m
-    rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive), heat, dTc)
+    rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive), heat, dTc, dxi)
     aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt.arm_m, dT)
     return rate, aux, wire_load(sigma, wire.area_m2, rt.dpath_dq)
 
@@ -64,7 +64,7 @@ def _wire_terms(model, state, inputs, geom, i):
 @njit(cache=True, inline="always")
 def derivative(state, inputs, model, geom):
     """(dstate/dt, aux): the derivative of the state and the algebraic quantities (loads, xi, sigma)."""
-    rates = filled(state.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0))
+    rates = filled(state.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     auxs = filled(state.wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     load = 0.0
     for i in range(len(state.wires)):  # one copy of the wire physics, whatever the wire count

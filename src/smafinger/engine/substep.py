@@ -15,6 +15,7 @@ from ..control.strategies import Command, opposing_wires_driven
 from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.records import Inputs, State, WireInput, WireState
+from ..model.wire import transformation_catch_up
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
 from .authors import Stages
 from .clock import TICKS_PER_S
@@ -39,9 +40,9 @@ STACK_CAPACITY = 64
 @njit(cache=True)
 def initial_state(model):
     w = model.wires
-    ws = filled(w, WireState(0.0, 0.0, 0.0, 0.0, 0.0))
+    ws = filled(w, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     for i in range(len(w)):
-        ws = set_item(ws, i, WireState(w[i].T_init_C, w[i].sigma0_Pa, 0.0, 0.0, w[i].T_amb_C))
+        ws = set_item(ws, i, WireState(w[i].T_init_C, w[i].sigma0_Pa, 0.0, 0.0, w[i].T_amb_C, w[i].xi_init))
     return State(model.dynamics.q0, 0.0, 0.0, ws)
 
 
@@ -150,10 +151,32 @@ def _after_step(model, y, stuck):
     if model.options.stress_law != StressLaw.ALGEBRAIC:
         for i in range(len(ws)):
             if ws[i].sigma_Pa < 0.0:
-                ws = set_item(ws, i, WireState(ws[i].T_C, 0.0, ws[i].electrical_J, ws[i].heat_J, ws[i].T_case_C))
+                ws = set_item(ws, i, with_field(ws[i], "sigma_Pa", 0.0))
     v = 0.0 if stuck else y.v
     q, v = end_stop(y.q, v, model.dynamics)
     return State(q, v, y.error_integral, ws)
+
+
+@njit(cache=True, inline="always")
+def _xi_restarted(y, aux):
+    """y with each wire's ``xi_integrated`` restarted at its xi (the sub-step start's, ``aux``)."""
+    ws = y.wires
+    for i in range(len(ws)):
+        ws = set_item(ws, i, with_field(ws[i], "xi_integrated", aux.wires[i].xi))
+    return State(y.q, y.v, y.error_integral, ws)
+
+
+@njit(cache=True, inline="always")
+def _xi_caught_up(model, y, inputs):
+    """y with each wire's stress caught up with its transformation over the sub-step (rate law,
+    :func:`~smafinger.model.wire.transformation_catch_up`)."""
+    if model.options.stress_law == StressLaw.ALGEBRAIC:
+        return y
+    ws = y.wires
+    for i in range(len(ws)):
+        sigma, xi = transformation_catch_up(model.wires[i], ws[i], inputs.wires[i].branch)
+        ws = set_item(ws, i, with_field(with_field(ws[i], "sigma_Pa", sigma), "xi_integrated", xi))
+    return State(y.q, y.v, y.error_integral, ws)
 
 
 @njit(cache=True, inline="always")
@@ -206,6 +229,7 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
             counters = with_field(counters, "sticks", counters.sticks + 1)
         stuck = new_stuck
         inputs = with_field(inputs, "stuck", stuck)
+    y = _xi_restarted(y, aux)
     return y, inputs, geom, geom_q, stuck, y.v, with_field(counters, "evals", evals), k1, aux, drives
 
 
@@ -221,6 +245,7 @@ def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, p
     if b > a:
         stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end, error_major)
         y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
+        y = _xi_caught_up(model, y, inputs)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):

@@ -109,6 +109,10 @@ class WireState(NamedTuple):
     electrical_J: float  #: electrical energy delivered at its terminals
     heat_J: float  #: Joule heat the model puts into the wire (Eq. 11's P' times L_w)
     T_case_C: float  #: air inside the actuator casing (two-node model; the ambient otherwise)
+    #: xi as the rate law's stress has taken it in over the sub-step: restarted at the kinetics' xi at
+    #: each sub-step start, integrated with the stress (dxi/dt of Eq. 7b), caught up with xi at its end
+    #: (:func:`smafinger.model.wire.transformation_catch_up`); unused by the algebraic law
+    xi_integrated: float
 
 
 class State(NamedTuple):

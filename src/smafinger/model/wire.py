@@ -97,13 +97,14 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
 
 @njit(cache=True, inline="always")
 def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
-    """A wire's (dT/dt, dsigma/dt, dT_case/dt) and (sigma, xi, spring elongation).
+    """A wire's (dT/dt, dsigma/dt, dT_case/dt, dxi/dt) and (sigma, xi, spring elongation).
 
     ``route_now``: the wire's :class:`~smafinger.model.kinematics.WireGeometry` at the current q;
     ``wi`` the wire's held inputs.
-    Rate law: dsigma/dt of Eq. (7b) with dxi/dt = xi_T T' + xi_sigma sigma'; with the latent heat
-    on, T' and sigma' are solved together. Algebraic law: sigma solved with xi; the latent heat
-    then takes dxi/dt = xi_T T' (sigma's own rate is not part of the state).
+    Rate law: dsigma/dt of Eq. (7b) with dxi/dt = xi_T T' + xi_sigma sigma' (returned: the rate of
+    the state's ``xi_integrated``); with the latent heat on, T' and sigma' are solved together.
+    Algebraic law: sigma solved with xi; the latent heat then takes dxi/dt = xi_T T' (sigma's own
+    rate is not part of the state); the returned dxi/dt is 0 (no stress to catch up).
     """
     path, dpath = route_now.path_m, route_now.dpath_dq
     T = ws.T_C
@@ -113,11 +114,38 @@ def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
         sigma, xi, x_s = algebraic_stress(wire, total_strain(wire, path), T, wi.branch)
         if wire.latent_heat_J_kg != 0.0:
             dT0 = latent_heat_rate(dT0, 0.0, 0.0, xi_on_branch(wi.branch, T, sigma, wire)[1], 0.0, wire)
-        return dT0, 0.0, dTc, sigma, xi, x_s
+        return dT0, 0.0, dTc, 0.0, sigma, xi, x_s
     sigma = ws.sigma_Pa
     xi, xT, xs = xi_on_branch(wi.branch, T, sigma, wire)
     D_eq, x_s = rate_law_modulus(wire, sigma, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))
     deps = dpath * v / wire.wire_length_m  # Eq. (6): Delta eps = Delta path / L_w
     den = 1.0 + D_eq * wire.eps_R * xs
     dT = latent_heat_rate(dT0, D_eq * deps / den, D_eq * wire.eps_R * xT / den, xT, xs, wire)
-    return dT, stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma), dTc, sigma, xi, x_s
+    dsigma = stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma)
+    return dT, dsigma, dTc, xT * dT + xs * dsigma, sigma, xi, x_s
+
+
+@njit(cache=True, inline="always")
+def transformation_catch_up(wire, ws, branch):
+    """Eq. (7b) over a sub-step: (sigma, xi_integrated) once the stress has taken the sub-step's
+    whole transformation increment.
+
+    The rate law integrates dsigma/dt = D_eq (deps/dt - eps_R dxi/dt) with dxi/dt = xi_T T' +
+    xi_sigma sigma'; ``ws.xi_integrated`` is that dxi/dt integrated alongside (from xi at the
+    sub-step start), while xi itself is the kinetics branch's value at (T, sigma). Where xi is
+    smooth over the sub-step the two agree to the integrator's order. The return-point memory makes
+    xi piecewise within a sub-step (held while tau is back from its extreme, then on the branch,
+    then on the parent past a target: a kink in every PWM period of a slow transformation), and a
+    fixed-step quadrature of dxi/dt across a kink misses an O(1) share of the increment after it:
+    the stress then lags the transformation strain for good. The stress takes the rest,
+    dxi = xi - xi_integrated, as Eq. (7b) does with xi's own dependence on sigma:
+    dsigma = -D_eq eps_R dxi / (1 + D_eq eps_R xi_sigma), D_eq at the sub-step's end (Eq. 8).
+    """
+    xi, _, xs = xi_on_branch(branch, ws.T_C, ws.sigma_Pa, wire)
+    missed = xi - ws.xi_integrated
+    if missed == 0.0:
+        return ws.sigma_Pa, xi
+    D_eq = rate_law_modulus(wire, ws.sigma_Pa, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))[0]
+    k = D_eq * wire.eps_R
+    dsigma = -k * missed / (1.0 + k * xs)
+    return ws.sigma_Pa + dsigma, xi + xs * dsigma
