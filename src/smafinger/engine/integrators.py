@@ -15,9 +15,10 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
 - ``authors-ode4``: the authors' Simulink solver (ode4, classical RK4 at a fixed 1 ms step,
   MODEL-NOTES) with the PWM read at its stage times (:mod:`.pwm`, ``sampled``), the controller
   re-evaluated at every stage and its error rate from their Derivative block (:mod:`.authors`),
-  as their model does. Not enough to reproduce their published temperatures: profile 2's
-  lower-wire peak is 151.6 degC with it, 123.6 degC with the resolved PWM, 135 degC in their
-  plots (docs/speed.md).
+  and their martensite functions called at every stage with the branch of the stage's own
+  dT/dt, their globals changed by every call (:mod:`smafinger.model.hysteresis_authors`), as
+  their model does. Profile 2's lower-wire peak is 134.9 degC with it (their plots: 135 degC;
+  123.6 degC with rk4 and the resolved PWM; docs/speed.md).
 """
 
 from __future__ import annotations

@@ -1,21 +1,24 @@
 """Eqs. (9)-(10) as the authors' Simulink model runs them: one call per model evaluation.
 
 Their martensite-fraction functions (``Code/SMA1_Martensite_Fraction.m`` and
-``SMA2_Martensite_Fraction.m`` in gabrielegilardi/FingerControl) keep three globals per wire,
+``SMA2_Martensite_Fraction.m`` in gabrielegilardi/FingerControl, commit 8910187; lines below are
+SMA1's) keep three globals per wire,
 ``Es`` (the heating branch's start, Eq. 9b's xi_M0), ``Ef`` (the cooling branch's start,
 Eq. 10b's xi_A0) and ``Esave`` (the last output), and change them at every call:
 
-- the branch is the sign of the call's own dT/dt (``phase = u(1)``), wired from the heat
+- the branch is the sign of the call's own dT/dt (l. 14, 28, 47, 66), wired from the heat
   model's integrator input at the same evaluation (``Finger_Full_Model.mdl``, the bus into
   "Phase Transformation Model SMA 1", SID 288);
-- heating: E = Es (T < Ua), Es (1 + kA) / 2 (Ua <= T <= La), 0 (T > La); then Ef is re-solved
-  so that the cooling branch passes through E: (2E - (1 + kM)) / (1 - kM) below Lm, E above;
-- cooling: E = Ef (T > Lm), Ef + (1 - Ef)(1 + kM) / 2 (Um <= T <= Lm), 1 (T < Um); then Es
-  is re-solved so that the heating branch passes through E: 2E / (1 + kA) above Ua, E below;
-- dT/dt = 0: E = Esave; Esave = E after every call.
+- heating: E = Es (T < Ua), Es (1 + kA) / 2 (Ua <= T <= La), 0 (T > La) (l. 30-36); then Ef is
+  re-solved so that the cooling branch passes through E: (2E - (1 + kM)) / (1 - kM) below Lm,
+  E above (l. 38-42);
+- cooling: E = Ef (T > Lm), Ef + (1 - Ef)(1 + kM) / 2 (Um <= T <= Lm), 1 (T < Um) (l. 49-55);
+  then Es is re-solved so that the heating branch passes through E: 2E / (1 + kA) above Ua,
+  E below (l. 57-61);
+- dT/dt = 0: E = Esave (l. 66-68); Esave = E after every call (l. 70).
 
-kA = cos(a_A (T - A_s) + b_A sigma) and kM = cos(a_M (T - M_f) + b_M sigma) are the raw
-cosines, not the major curves clamped at their ends: above La the re-solved Es is
+kA = cos(a_A (T - A_s) + b_A sigma) and kM = cos(a_M (T - M_f) + b_M sigma) (l. 24-25) are the
+raw cosines, not the major curves clamped at their ends: above La the re-solved Es is
 2E / (1 + kA) with 1 + kA small (the branch keeps E at the current point), where the clamped
 curve would give 0 and lose the point.
 
