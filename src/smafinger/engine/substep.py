@@ -19,7 +19,7 @@ from ..model.records import Inputs, State, WireInput, WireState
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
 from .authors import Stages, call_branches, commit_calls
 from .clock import TICKS_PER_S
-from .integrators import step
+from .integrators import Method, step
 from .pwm import PwmModel, averaged_drive, sampled_drive
 from .rhs import derivative, geometry_at
 from .tuples import filled, set_item, with_field
@@ -200,13 +200,16 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
     evals = counters.evals
     kinetics_done = False
     stick_done = False
-    inputs = call_branches(model, y, inputs)  # the authors' martensite calls (rule AUTHORS_CALLS only)
+    calls = run.method == Method.AUTHORS_ODE4  # the authors' martensite calls (rule AUTHORS_CALLS)
+    if calls:
+        inputs = call_branches(model, y, inputs)
     for _ in range(3):  # one call site: derivative is compiled inline once here
         k1, aux = derivative(y, inputs, model, geom)
         evals += 1
         if not kinetics_done:
             kinetics_done = True
-            inputs = commit_calls(model, y, inputs, aux)
+            if calls:
+                inputs = commit_calls(model, y, inputs, aux)
             inputs, changed = _update_kinetics(model, y, inputs, k1, aux, stacks)
             if changed:
                 continue
