@@ -17,6 +17,11 @@ and each of these evaluations runs the control blocks:
   taken, at the stages the difference from t_n;
 - the PWM wave read at the call's time (:func:`.pwm.sampled_phases`).
 
+- their martensite-fraction functions called once per evaluation, the branch from that
+  evaluation's dT/dt, their globals changed by every call
+  (:mod:`smafinger.model.hysteresis_authors`): :func:`call_branches` before an evaluation,
+  :func:`commit_calls` after it.
+
 :func:`stage_inputs` builds a later stage's inputs; :func:`major_commands` the major step's.
 A run with a controller period, or an open-loop program, keeps the commands of its tick at the
 stages and only reads the PWM wave at the stage's phase.
@@ -30,6 +35,9 @@ from numba.extending import overload
 from ..control.controller import integrating_flag, phase_commands
 from ..control.pid import on_time, pid_output
 from ..control.strategies import Strategy
+from ..model.heat import wire_temperature_rate
+from ..model.hysteresis import AUTHORS_CALLS
+from ..model.hysteresis_authors import call_record, committed_call
 from ..model.records import Controller, WireInput
 from .clock import TICKS_PER_S
 from .pwm import sampled_drive
@@ -129,4 +137,36 @@ def stage_inputs(model, inputs, y, st, phase, since):
         c = cmds[i]
         d = sampled_drive(c.level, st.low, c.duty, on_time(c.duty, period), phase)
         wis = set_item(wis, i, WireInput(d, c.heating, wis[i].branch, wis[i].depth))
+    return with_field(inputs, "wires", wis)
+
+
+@njit(cache=True, inline="always")
+def call_branches(model, y, inputs):
+    """``inputs`` with each wire's branch for an evaluation at state ``y``: the authors' call
+    (rule ``AUTHORS_CALLS``) takes the sign of its own dT/dt (Eq. 11 at the evaluation's drive
+    and phase; their model has no latent heat); any other rule keeps its branch."""
+    wis = inputs.wires
+    for i in range(len(wis)):
+        wi = wis[i]
+        if wi.branch.rule != AUTHORS_CALLS:
+            continue
+        wire, ws = model.wires[i], y.wires[i]
+        dT = wire_temperature_rate(wire, ws.T_C, ws.T_case_C, wi.drive, wi.heating, inputs.current_drive,
+                                   model.options)
+        wis = set_item(wis, i, WireInput(wi.drive, wi.heating, call_record(wi.branch, dT), wi.depth))
+    return with_field(inputs, "wires", wis)
+
+
+@njit(cache=True, inline="always")
+def commit_calls(model, y, inputs, aux):
+    """``inputs`` with the authors' globals after the evaluation at ``y`` that gave ``aux``
+    (each wire's xi and stress there; rule ``AUTHORS_CALLS`` only)."""
+    wis = inputs.wires
+    for i in range(len(wis)):
+        wi = wis[i]
+        if wi.branch.rule != AUTHORS_CALLS:
+            continue
+        a = aux.wires[i]
+        rec = committed_call(wi.branch, y.wires[i].T_C, a.sigma_Pa, a.xi, model.wires[i])
+        wis = set_item(wis, i, WireInput(wi.drive, wi.heating, rec, wi.depth))
     return with_field(inputs, "wires", wis)

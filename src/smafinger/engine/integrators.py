@@ -15,9 +15,10 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
 - ``authors-ode4``: the authors' Simulink solver (ode4, classical RK4 at a fixed 1 ms step,
   MODEL-NOTES) with the PWM read at its stage times (:mod:`.pwm`, ``sampled``), the controller
   re-evaluated at every stage and its error rate from their Derivative block (:mod:`.authors`),
-  as their model does. Not enough to reproduce their published temperatures: profile 2's
-  lower-wire peak is 151.6 degC with it, 123.6 degC with the resolved PWM, 135 degC in their
-  plots (docs/speed.md).
+  and their martensite functions called at every stage with the branch of the stage's own
+  dT/dt, their globals changed by every call (:mod:`smafinger.model.hysteresis_authors`), as
+  their model does. Profile 2's lower-wire peak is 134.9 degC with it (their plots: 135 degC;
+  123.6 degC with rk4 and the resolved PWM; docs/speed.md).
 """
 
 from __future__ import annotations
@@ -30,9 +31,9 @@ import math
 from numba import njit
 
 from ..model.records import State, WireState
-from .authors import stage_inputs
+from .authors import call_branches, commit_calls, stage_inputs
 from .rhs import derivative, geometry_at
-from .tuples import set_item
+from .tuples import set_item, with_field
 
 
 class Method(IntEnum):
@@ -115,20 +116,22 @@ def _damped_mechanism(method, y, k1, h, c):
 
 @njit(cache=True, inline="always")
 def step(method, model, y, h, inputs, k1, geom, stages):
-    """y advanced by h (see the module docstring for the methods). Returns (y, evaluations).
+    """y advanced by h (see the module docstring for the methods). Returns (y, evaluations, inputs).
 
     RK4 as a loop over its three later stages (one right-hand-side call site, so that it is
     compiled once): the weighted sum accumulates k1 + 2 k2 + 2 k3 + k4 in that order.
     ``authors-ode4``: each later stage's inputs come from the controller at that stage's state
     and the PWM read at its phase (:func:`.authors.stage_inputs`); ``stages``
-    (:class:`.authors.Stages`) is what they need.
+    (:class:`.authors.Stages`) is what they need; each stage is one call of the authors'
+    martensite functions (:func:`.authors.call_branches`, :func:`.authors.commit_calls`), and the
+    returned ``inputs`` carry their globals after the last stage (otherwise ``inputs`` as given).
     """
     if method == Method.EULER:
-        return axpy(y, h, k1), 0
+        return axpy(y, h, k1), 0, inputs
     if method == Method.SEMI_IMPLICIT or method == Method.EXPONENTIAL:
         ye = axpy(y, h, k1)
         q, v = _damped_mechanism(method, y, k1, h, inputs.viscous / model.dynamics.inertia)
-        return State(q, v, ye.error_integral, ye.wires), 0
+        return State(q, v, ye.error_integral, ye.wires), 0, inputs
     half = 0.5 * h
     acc = k1
     k = k1
@@ -142,6 +145,9 @@ def step(method, model, y, h, inputs, k1, geom, stages):
         if method == Method.AUTHORS_ODE4:
             since = h if stage == 2 else half
             inp = stage_inputs(model, inputs, yk, stages, stages.phase_end if stage == 2 else stages.phase_mid, since)
-        k = derivative(yk, inp, model, g)[0]
+            inp = call_branches(model, yk, inp)
+        k, aux = derivative(yk, inp, model, g)
+        if method == Method.AUTHORS_ODE4:
+            inputs = with_field(inputs, "wires", commit_calls(model, yk, inp, aux).wires)
         acc = axpy(acc, 1.0 if stage == 2 else 2.0, k)
-    return axpy(y, h / 6.0, acc), 3
+    return axpy(y, h / 6.0, acc), 3, inputs

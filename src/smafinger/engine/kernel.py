@@ -30,7 +30,9 @@ from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, confirm_tick, track_reach
 from .signals import record_sample
-from .substep import STACK_CAPACITY, Counters, decide, initial_commands, initial_inputs, initial_state, integrate
+from .integrators import Method
+from .substep import (STACK_CAPACITY, Counters, authors_calls_inputs, decide, initial_commands, initial_inputs,
+                      initial_state, integrate)
 from .tuples import filled, with_field
 
 
@@ -156,6 +158,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     """
     y = initial_state(model)
     inputs = initial_inputs(model, run.current_drive)
+    if run.method == Method.AUTHORS_ODE4:  # the authors' solver: their martensite functions' calls
+        inputs = authors_calls_inputs(inputs, model)
     cmds = initial_commands(model)
     ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
     s = Schedule(0, model.dynamics.q0, 0, -1, False, -1, -1, -1, False)
@@ -220,7 +224,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             if out_i < n_out and (next_out < a or (final and next_out == a)):
                 out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
-            y, counters, t_fail = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
+            y, counters, t_fail, inputs = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
                                             phase_mid, phase_end, memory.error)
             if counters.status != 0:
                 return counters, y, t_fail

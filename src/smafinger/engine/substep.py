@@ -14,12 +14,13 @@ from ..control.pid import on_time, pwm_output
 from ..control.strategies import Command, opposing_wires_driven
 from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
+from ..model.hysteresis_authors import initial_calls_record
 from ..model.records import Inputs, State, WireInput, WireState
 from ..model.wire import transformation_catch_up
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
-from .authors import Stages
+from .authors import Stages, call_branches, commit_calls
 from .clock import TICKS_PER_S
-from .integrators import step
+from .integrators import Method, step
 from .pwm import PwmModel, averaged_drive, sampled_drive
 from .rhs import derivative, geometry_at
 from .tuples import filled, set_item, with_field
@@ -65,6 +66,19 @@ def initial_inputs(model, current_drive):
     for i in range(1, len(w)):
         wi = set_item(wi, i, WireInput(0.0, False, _initial_branch(w[i], rule), 0))
     return Inputs(False, 0.0, model.dynamics.q0, 1.0, current_drive, wi)
+
+
+@njit(cache=True)
+def authors_calls_inputs(inputs, model):
+    """``inputs`` for the authors' solver: a wire on the authors2020 rule gets their martensite
+    functions' globals (:func:`~smafinger.model.hysteresis_authors.initial_calls_record`)."""
+    wis = inputs.wires
+    for i in range(len(wis)):
+        wi = wis[i]
+        if wi.branch.rule == AUTHORS2020:
+            rec = initial_calls_record(model.wires[i].xi_init)
+            wis = set_item(wis, i, WireInput(wi.drive, wi.heating, rec, wi.depth))
+    return with_field(inputs, "wires", wis)
 
 
 @njit(cache=True)
@@ -209,11 +223,16 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
     evals = counters.evals
     kinetics_done = False
     stick_done = False
+    calls = run.method == Method.AUTHORS_ODE4  # the authors' martensite calls (rule AUTHORS_CALLS)
+    if calls:
+        inputs = call_branches(model, y, inputs)
     for _ in range(3):  # one call site: derivative is compiled inline once here
         k1, aux = derivative(y, inputs, model, geom)
         evals += 1
         if not kinetics_done:
             kinetics_done = True
+            if calls:
+                inputs = commit_calls(model, y, inputs, aux)
             inputs, changed = _update_kinetics(model, y, inputs, k1, aux, stacks)
             if changed:
                 continue
@@ -240,14 +259,15 @@ def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, p
     With the authors' solver the later stages read the controller and the PWM at their own
     states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
     schedule, ``error_major``: q_F - q at the major step; see :func:`.authors.stage_inputs`). Returns (y, counters,
-    t_fail_s); ``counters.status`` is 1 if the state is no longer finite.
+    t_fail_s, inputs); ``counters.status`` is 1 if the state is no longer finite; ``inputs`` carry the
+    authors' martensite globals after the step (:func:`.integrators.step`).
     """
     if b > a:
         stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end, error_major)
-        y, n = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
+        y, n, inputs = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
         y = _xi_caught_up(model, y, inputs)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
-        return y, with_field(counters, "status", 1), b * run.tick_s
-    return y, counters, 0.0
+        return y, with_field(counters, "status", 1), b * run.tick_s, inputs
+    return y, counters, 0.0, inputs

@@ -47,8 +47,12 @@ from .kinetics import COOLING, HEATING, HOLD, branch_start, g_cooling, g_heating
 MEMORY = 0
 AUTHORS2020 = 1
 DEADBAND = 2
+#: the authors' rule as their Simulink model runs it, one call per model evaluation
+#: (:mod:`smafinger.model.hysteresis_authors`; method ``authors-ode4`` only, not a user's choice)
+AUTHORS_CALLS = 3
 RULES = {"memory": MEMORY, "authors2020": AUTHORS2020, "deadband": DEADBAND}
 DEFAULT_RULE = "memory"
+UNCLIPPED = False
 DEFAULT_CAPACITY = 64
 MIN_CAPACITY = 4
 
@@ -76,7 +80,9 @@ class BranchRecord(NamedTuple):
     major curve); past it ``xi_on_branch`` continues on the parent branch (the branch that
     led to the target), so the evaluation stays continuous within a sub-step.
     ``turn_C`` and ``reversal_C`` belong to the dead-band rule; ``clamps`` counts committed
-    clamps to the major loop, ``merges`` stack-overflow merges (memory rule).
+    clamps to the major loop, ``merges`` stack-overflow merges (memory rule). Rule
+    ``AUTHORS_CALLS`` keeps the authors' globals Es, Ef, Esave in ``parent_x0``,
+    ``parent_slope`` and ``target_xi`` (:mod:`smafinger.model.hysteresis_authors`).
     """
 
     rule: int
@@ -193,7 +199,8 @@ def xi_on_branch(rec, T, sigma, m):
     branch's tau is back from its extreme (``lim_tau``), the parent branch is used once tau
     has reached the target, and the result is kept inside the major loop
     g_M(tau_M) <= xi <= g_A(tau_A) (a rounding-level guard; see ``update_memory``).
-    Legacy rules: ``kinetics.martensite_fraction``'s operations, clipped to [0, 1].
+    Legacy rules: ``kinetics.martensite_fraction``'s operations, clipped to [0, 1] (not
+    ``AUTHORS_CALLS``: the authors' functions do not clip).
     """
     d = rec.direction
     if d == 0:
@@ -204,6 +211,8 @@ def xi_on_branch(rec, T, sigma, m):
         else:
             g, gT, gs = g_cooling(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C)
         xi = rec.x0 + rec.slope * (g - rec.g0)
+        if rec.rule == AUTHORS_CALLS:  # their E is not clipped
+            return xi, rec.slope * gT, rec.slope * gs
         if xi > 1.0:
             return 1.0, 0.0, 0.0
         if xi < 0.0:
@@ -299,6 +308,8 @@ def update_memory(rec, stack, depth, T, sigma, direction, m):
     through it. ``direction`` 0 keeps the branch. Legacy rules: today's branch selection.
     Returns (record, depth).
     """
+    if rec.rule == AUTHORS_CALLS:  # each call commits its own globals (hysteresis_authors)
+        return rec, depth
     if rec.rule != MEMORY:
         return _legacy_update(rec, T, sigma, direction, m), depth
     out = memory_update(rec.direction, rec.x0, rec.g0, rec.slope, rec.lim_tau, rec.lim_g,
