@@ -204,6 +204,20 @@ def test_hysteresis_findings_count_what_the_step_recovers():
     assert "what the change broke" not in text and "1 of the 1 targets lost at 1 ms and run at 0.1 ms" in text
 
 
+def test_hysteresis_findings_compare_the_two_steps_target_by_target():
+    from smafinger.paper.cycle_findings import hysteresis_findings
+
+    table = [{"scenario": "a", "as-specified": _brief(5.0, 6.30, -40.0), "dt0.1ms": _brief(5.001, 6.32, -40.0)},
+             {"scenario": "b", "as-specified": _brief(4.0, None, -41.0), "dt0.1ms": _brief(4.0, 3.0, -40.0)},
+             {"scenario": "c", "as-specified": _brief(4.0, 3.0, -40.0)}]
+    text = "\n".join(hysteresis_findings(table))
+    assert ("3 targets reached at both, their reach times 1.0 ms apart at the median and at most 20.0 ms (`a` move 2); "
+            "reached at one step only: `b` move 2.") in text
+    assert "`c`" not in text
+    text = "\n".join(hysteresis_findings([{k: v for k, v in row.items() if k != "dt0.1ms"} for row in table]))
+    assert "The 1 ms step against 0.1 ms" not in text
+
+
 def _cycle(key, reach, sched):
     row = {"key": key, "reading": key, "short": key}
     for kind, (i, c) in (("reach", reach), ("schedule", sched)):

@@ -2,8 +2,9 @@
 (Fig. 13), parameter set ``paper2010`` (Sec. 3.2 coefficients, PID of Sec. 4). Fig. 11 is in
 :mod:`.fig11`.
 
-The returns are reached at the scenarios' 1 ms step as at 0.1 ms (within 2 ms): the rate-form
-stress law (Eq. 7b) takes each sub-step's whole transformation increment
+The returns are reached at the scenarios' 1 ms step as at 0.1 ms (Fig. 12 within 2 ms, Fig. 13's
+extension returns within 23 ms; report.md's step-size check): the rate-form stress law (Eq. 7b)
+takes each sub-step's whole transformation increment
 (:func:`smafinger.model.wire.transformation_catch_up`). Before that, the minor loops the PWM
 drives under the memory rule (issue 10) made it drift at 1 ms and the returns ended 1-3 deg off
 -40 deg. Fig. 12's returns are reached sooner than the paper's "almost 10 s" (a known gap).
