@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from smafinger.bench.tasks import Task
-from smafinger.bench.tune import (HEAT_PENALTY_PER_C, UNREACHED_PENALTY, VIOLATION_PENALTY, FreeParam,
-                                  objective)
+from smafinger.bench.tune import (HEAT_PENALTY_PER_C, HEAT_STEP_PENALTY, UNREACHED_PENALTY, VIOLATION_PENALTY,
+                                  FreeParam, objective)
 from smafinger.cli import app
 
 
@@ -43,8 +43,24 @@ def test_objective_is_relative_measure_plus_penalties():
             {"rms_error": 1.0, "unreached": 0, "interlock_violations": 0, "peak_T_C": 90.0}]
     assert objective([cyc, mov], good, ref, 100.0) == pytest.approx((0.6 + 0.5) / 2)
     bad = [dict(good[0], cycle_s=None, unreached=1, peak_T_C=110.0), dict(good[1], interlock_violations=2)]
-    expected = (60.0 / 10.0 + UNREACHED_PENALTY + 10.0 * HEAT_PENALTY_PER_C + 0.5 + 2 * VIOLATION_PENALTY) / 2
+    expected = (60.0 / 10.0 + UNREACHED_PENALTY + HEAT_STEP_PENALTY + 10.0 * HEAT_PENALTY_PER_C + 0.5 + 2 * VIOLATION_PENALTY) / 2
     assert objective([cyc, mov], bad, ref, 100.0) == pytest.approx(expected)
+
+
+@pytest.mark.parametrize("over_C", [1e-3, 0.11, 1.17, 5.0])
+def test_a_hotter_faster_candidate_ranks_below_a_cooler_slower_one(over_C):
+    """The peak limit is hard: a cycle that is 30 % faster than the paper's PID but a fraction of a
+    degree hotter than the limit scores worse than one only as fast as the PID within it (with the
+    old soft 0.1 per degC it scored better)."""
+    cyc = Task("c", "joint", "cycle", "", 60.0, "c")
+    ref = [{"cycle_s": 15.0, "peak_T_C": 103.0}]
+    base = {"unreached": 0, "interlock_violations": 0}
+    hot_fast = [dict(base, cycle_s=0.7 * 15.0, peak_T_C=103.0 + over_C)]
+    cool_slow = [dict(base, cycle_s=15.0, peak_T_C=103.0)]
+    assert objective([cyc], hot_fast, ref, 103.0) > objective([cyc], cool_slow, ref, 103.0)
+    # and over-limit candidates rank among themselves by how far over they are
+    hotter = [dict(hot_fast[0], peak_T_C=103.0 + over_C + 0.5)]
+    assert objective([cyc], hotter, ref, 103.0) > objective([cyc], hot_fast, ref, 103.0)
 
 
 def test_a_tiny_tuning_end_to_end(tmp_path):

@@ -3,9 +3,15 @@
 The objective of a candidate is the mean over its tasks of the task's measure divided by the
 paper's PWM-PID's on the same task (so 0.5 is twice as good as the paper): the cycle time for
 a ``cycle`` task, the RMS tracking error for the others. Constraints are penalties added to
-it: each unreached target 1.0, each interlock violation 1.0, and 0.1 per degC by which the
-hottest wire exceeds ``max_peak_T_C`` (default: the paper's PID's own peak on the same tasks,
-so a tuned controller may not heat the wires more than the paper's does). A candidate whose
+it: each unreached target 1.0, each interlock violation 1.0. The peak temperature is a hard
+limit, not a trade: ``max_peak_T_C`` (default: the paper's PID's own peak on the same tasks,
+so a tuned controller may not heat the wires more than the paper's does). A task whose hottest
+wire exceeds it costs a step of 1.0 plus 1.0 per degC over. The step is the paper's PID's whole
+measure, so a candidate over the limit (measure > 0, plus at least 1.0) ranks below every
+candidate within it that is at least as good as the paper's PID (objective at most 1.0), i.e.
+below every candidate a tuning could return as an improvement, however much faster it is; the
+slope ranks over-limit candidates by how far over they are, which leads the search back inside.
+CMA-ES uses only the ranks of the objectives, so a step does not hamper it. A candidate whose
 values are inconsistent (a fuzzy K_P_min above K_P_max) is not run and scores :data:`INVALID`.
 
 Free parameters (:class:`FreeParam`) live in a box; gains are searched on a log scale. Every
@@ -32,7 +38,9 @@ from .tasks import Task
 #: penalty weights (objective units: 1.0 = the paper's PID on a task)
 UNREACHED_PENALTY = 1.0
 VIOLATION_PENALTY = 1.0
-HEAT_PENALTY_PER_C = 0.1
+#: a task over the peak temperature limit: a step, plus a slope per degC over
+HEAT_STEP_PENALTY = 1.0
+HEAT_PENALTY_PER_C = 1.0
 #: the objective of a candidate whose values are inconsistent (no run made)
 INVALID = 100.0
 
@@ -119,6 +127,13 @@ def task_measure(task: Task, scores: dict) -> float | None:
     return scores.get("cycle_s") if task.kind == "cycle" else scores["rms_error"]
 
 
+def heat_penalty(peak_T_C: float, max_peak_T_C: float) -> float:
+    """The penalty of a task whose hottest wire peaked at ``peak_T_C``: 0 within the limit, else a
+    step of :data:`HEAT_STEP_PENALTY` plus :data:`HEAT_PENALTY_PER_C` per degC over."""
+    over = peak_T_C - max_peak_T_C
+    return HEAT_STEP_PENALTY + HEAT_PENALTY_PER_C * over if over > 0.0 else 0.0
+
+
 def objective(tasks: Sequence[Task], scores: Sequence[dict], reference: Sequence[dict], max_peak_T_C: float) -> float:
     """The tuning objective of one candidate (see the module docstring)."""
     total = 0.0
@@ -128,7 +143,7 @@ def objective(tasks: Sequence[Task], scores: Sequence[dict], reference: Sequence
             m = task.t_end_s
         total += m / m_ref if m_ref else m
         total += UNREACHED_PENALTY * s.get("unreached", 0) + VIOLATION_PENALTY * s["interlock_violations"]
-        total += HEAT_PENALTY_PER_C * max(0.0, s["peak_T_C"] - max_peak_T_C)
+        total += heat_penalty(s["peak_T_C"], max_peak_T_C)
     return total / len(tasks)
 
 
