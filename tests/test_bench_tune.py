@@ -43,7 +43,8 @@ def test_objective_is_relative_measure_plus_penalties():
             {"rms_error": 1.0, "unreached": 0, "interlock_violations": 0, "peak_T_C": 90.0}]
     assert objective([cyc, mov], good, ref, 100.0) == pytest.approx((0.6 + 0.5) / 2)
     bad = [dict(good[0], cycle_s=None, unreached=1, peak_T_C=110.0), dict(good[1], interlock_violations=2)]
-    expected = (60.0 / 10.0 + UNREACHED_PENALTY + HEAT_STEP_PENALTY + 10.0 * HEAT_PENALTY_PER_C + 0.5 + 2 * VIOLATION_PENALTY) / 2
+    expected = (60.0 / 10.0 + UNREACHED_PENALTY + HEAT_STEP_PENALTY + 10.0 * HEAT_PENALTY_PER_C
+                + 0.5 + 2 * VIOLATION_PENALTY) / 2
     assert objective([cyc, mov], bad, ref, 100.0) == pytest.approx(expected)
 
 

@@ -9,7 +9,8 @@ so a tuned controller may not heat the wires more than the paper's does). A task
 wire exceeds it costs a step of 1.0 plus 1.0 per degC over. The step is the paper's PID's whole
 measure, so a candidate over the limit (measure > 0, plus at least 1.0) ranks below every
 candidate within it that is at least as good as the paper's PID (objective at most 1.0), i.e.
-below every candidate a tuning could return as an improvement, however much faster it is; the
+below every candidate a tuning could return as an improvement, however much faster it is (on
+one task, as the bench's tunings are; over several tasks it is averaged like every penalty). The
 slope ranks over-limit candidates by how far over they are, which leads the search back inside.
 CMA-ES uses only the ranks of the objectives, so a step does not hamper it. A candidate whose
 values are inconsistent (a fuzzy K_P_min above K_P_max) is not run and scores :data:`INVALID`.
