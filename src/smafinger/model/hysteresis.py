@@ -185,7 +185,7 @@ def initial_record(rule, xi_init, T_init, reversal_C):
     return rec, 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def xi_on_branch(rec, T, sigma, m):
     """xi and its partial derivatives (dxi/dT, dxi/dsigma) on the record's branch.
 
@@ -238,7 +238,7 @@ def xi_on_branch(rec, T, sigma, m):
     return xi, xT, xs
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def drive_direction(rec, dT_dt, dsigma_dt, m):
     """Direction for ``update_memory`` from the derivatives at a sub-step start.
 
@@ -289,7 +289,7 @@ def _legacy_update(rec, T, sigma, direction, m):
                         turn, rec.reversal_C, rec.clamps, rec.merges)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update_memory(rec, stack, depth, T, sigma, direction, m):
     """Commit the sub-step's events at (T, sigma) and choose the branch for the next one.
 
