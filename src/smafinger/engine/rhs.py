@@ -72,6 +72,33 @@ def derivative(state, inputs, model, geom):
         rates = set_item(rates, i, r)
         auxs = set_item(auxs, i, a)
         load += l_i
+    return _with_mechanism(state, inputs, model, geom, rates, auxs, load)
+
+
+@njit(cache=True, inline="always")
+def derivative_redone(state, inputs, model, geom, prev, redo):
+    """:func:`derivative` where only the wires flagged in ``redo`` (a tuple of bools) may differ
+    from ``prev`` = (dstate/dt, aux) at the same state and geometry: their terms are computed
+    anew, the others' taken from ``prev``. The same bits as ``derivative`` when the other wires'
+    inputs are those of ``prev`` (a wire's load is recomputed from its stress, as there).
+    """
+    rates = prev[0].wires
+    auxs = prev[1].wires
+    load = 0.0
+    for i in range(len(state.wires)):
+        if redo[i]:
+            r, a, l_i = _wire_terms(model, state, inputs, geom, i)
+            rates = set_item(rates, i, r)
+            auxs = set_item(auxs, i, a)
+        else:
+            l_i = wire_load(auxs[i].sigma_Pa, model.wires[i].area_m2, geom.routes[i].dpath_dq)
+        load += l_i
+    return _with_mechanism(state, inputs, model, geom, rates, auxs, load)
+
+
+@njit(cache=True, inline="always")
+def _with_mechanism(state, inputs, model, geom, rates, auxs, load):
+    """The derivative from the wires' rates and summed load: the mechanism's rates (Eqs. 1-2, 12a)."""
     load += geom.external  # Eq. (1b): wires first, then gravity (or the bias spring)
     dyn = model.dynamics
     stuck = inputs.stuck

@@ -22,7 +22,8 @@ from .authors import Stages, call_branches, commit_calls
 from .clock import TICKS_PER_S
 from .integrators import Method, step
 from .pwm import PwmModel, averaged_drive, sampled_drive
-from .rhs import derivative, geometry_at
+from .dense import zero_aux
+from .rhs import derivative_redone, geometry_at
 from .tuples import filled, set_item, with_field
 
 
@@ -94,24 +95,33 @@ def _branch_moved(a, b):
 
 
 @njit(cache=True, inline="always")
+def _any(flags):
+    """True if any item of the tuple of bools ``flags`` is."""
+    out = False
+    for f in flags:
+        out = out or f
+    return out
+
+
+@njit(cache=True, inline="always")
 def _update_kinetics(model, y, inputs, k1, aux, stacks):
     """Each wire's kinetics branch for the sub-step, from the derivatives at its start (Eqs. 9-10).
 
     The direction (tau = T - sigma/c rising, falling or neither; the legacy rules: the sign of
     dT/dt) comes from k1; the memory commits the wipe-outs and reversals at the current point.
-    Returns (inputs, changed): ``changed`` if some wire's branch must be evaluated anew.
+    Returns (inputs, moved): ``moved[i]`` if wire i's branch must be evaluated anew.
     """
     wis = inputs.wires
-    changed = False
+    moved = filled(wis, False)
     for i in range(len(wis)):
         wi = wis[i]
         wire = model.wires[i]
         d = drive_direction(wi.branch, k1.wires[i].T_C, k1.wires[i].sigma_Pa, wire)
         rec, depth = update_memory(wi.branch, stacks[i], wi.depth, y.wires[i].T_C, aux.wires[i].sigma_Pa, d,
                                    wire)
-        changed = changed or _branch_moved(wi.branch, rec)
+        moved = set_item(moved, i, _branch_moved(wi.branch, rec))
         wis = set_item(wis, i, WireInput(wi.drive, wi.heating, rec, depth))
-    return with_field(inputs, "wires", wis), changed
+    return with_field(inputs, "wires", wis), moved
 
 
 @njit(cache=True, inline="always")
@@ -219,6 +229,7 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
         counters = with_field(counters, "violations", counters.violations + 1)
     # the derivative at the sub-step start; then the kinetics branches and Eq. (2) are decided from
     # it, and whenever a decision changes what the derivative depends on it is evaluated again
+    # (only the wires whose branch moved are evaluated again: the others' terms are unchanged)
     restick = model.options.friction_sticking == FrictionSticking.RESTICK
     evals = counters.evals
     kinetics_done = False
@@ -226,16 +237,19 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
     calls = run.method == Method.AUTHORS_ODE4  # the authors' martensite calls (rule AUTHORS_CALLS)
     if calls:
         inputs = call_branches(model, y, inputs)
+    redo = filled(model.wires, True)
+    k1, aux = State(0.0, 0.0, 0.0, filled(y.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))), zero_aux(model.wires)
     for _ in range(3):  # one call site: derivative is compiled inline once here
-        k1, aux = derivative(y, inputs, model, geom)
+        k1, aux = derivative_redone(y, inputs, model, geom, (k1, aux), redo)
         evals += 1
         if not kinetics_done:
             kinetics_done = True
             if calls:
                 inputs = commit_calls(model, y, inputs, aux)
-            inputs, changed = _update_kinetics(model, y, inputs, k1, aux, stacks)
-            if changed:
+            inputs, redo = _update_kinetics(model, y, inputs, k1, aux, stacks)
+            if _any(redo):
                 continue
+        redo = filled(model.wires, True)  # a stick/slip change: v and the mechanism's rates
         if stick_done:
             break
         stick_done = True

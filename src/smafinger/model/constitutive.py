@@ -44,19 +44,29 @@ def spring_force(x, K_S, x_limit, fact):
     return K_S * x + (math.sinh(u) - u) / (1000.0 * fact)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def spring_elongation(F, K_S, x_limit, fact):
     """Inverse of :func:`spring_force` (F >= 0).
 
-    Newton from the linear guess (a few iterations where the slack has not stiffened the spring
-    much); far up the cosh stiffening Newton from there moves too little per iteration, so if it
-    has not converged in 60 the root is bracketed and found by bisection-safeguarded Newton.
+    Linear below the stiffening (compiled in place: the usual case at every RHS stage); beyond
+    it :func:`_stiffened_elongation`.
     """
     if F <= 0.0:
         return 0.0
     x = F / K_S
     if x <= x_limit or fact == 0.0:
         return x
+    return _stiffened_elongation(F, K_S, x_limit, fact, x)
+
+
+@njit(cache=True)
+def _stiffened_elongation(F, K_S, x_limit, fact, x):
+    """:func:`spring_elongation` beyond the stiffening, from the linear guess x = F / K_S.
+
+    Newton from the linear guess (a few iterations where the slack has not stiffened the spring
+    much); far up the cosh stiffening Newton from there moves too little per iteration, so if it
+    has not converged in 60 the root is bracketed and found by bisection-safeguarded Newton.
+    """
     for _ in range(60):
         r = spring_force(x, K_S, x_limit, fact) - F
         k = spring_stiffness(x, K_S, x_limit, fact)

@@ -42,7 +42,8 @@ import numpy as np
 from numba import njit
 
 from .hysteresis_memory import STACK_COLUMNS, branch_target, memory_update
-from .kinetics import COOLING, HEATING, HOLD, branch_start, g_cooling, g_heating, next_branch
+from .kinetics import (COOLING, HEATING, HOLD, branch_start, g_cooling, g_cooling_upper_bound, g_heating,
+                       g_heating_lower_bound, next_branch)
 
 MEMORY = 0
 AUTHORS2020 = 1
@@ -191,7 +192,7 @@ def initial_record(rule, xi_init, T_init, reversal_C):
     return rec, 0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def xi_on_branch(rec, T, sigma, m):
     """xi and its partial derivatives (dxi/dT, dxi/dsigma) on the record's branch.
 
@@ -218,18 +219,17 @@ def xi_on_branch(rec, T, sigma, m):
         if xi < 0.0:
             return 0.0, 0.0, 0.0
         return xi, rec.slope * gT, rec.slope * gs
-    gA, gAT, gAs = g_heating(T, sigma, m.A_S0_C, m.A_F0_C, m.c_A_Pa_per_C)
-    gM, gMT, gMs = g_cooling(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C)
     if d > 0:
-        g, gT, gs = gA, gAT, gAs
+        own = g_heating(T, sigma, m.A_S0_C, m.A_F0_C, m.c_A_Pa_per_C)
         tau = T - sigma / m.c_A_Pa_per_C
         back = tau < rec.lim_tau
         past = tau >= rec.target_tau
     else:
-        g, gT, gs = gM, gMT, gMs
+        own = g_cooling(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C)
         tau = T - sigma / m.c_M_Pa_per_C
         back = tau > rec.lim_tau
         past = tau <= rec.target_tau
+    g, gT, gs = own
     if back:
         x0, g0, b = rec.x0, rec.g0, rec.slope
         g, gT, gs = rec.lim_g, 0.0, 0.0
@@ -237,17 +237,35 @@ def xi_on_branch(rec, T, sigma, m):
         x0, g0, b = rec.parent_x0, rec.parent_g0, rec.parent_slope
     else:
         x0, g0, b = rec.x0, rec.g0, rec.slope
-    xi = x0 + b * (g - g0)
-    xT = b * gT
-    xs = b * gs
-    if xi < gM:
-        xi, xT, xs = gM, gMT, gMs
-    if xi > gA:
-        xi, xT, xs = gA, gAT, gAs
+    return _into_major_loop(d, own, x0 + b * (g - g0), b * gT, b * gs, T, sigma, m)
+
+
+@njit(cache=True, inline="always")
+def _into_major_loop(d, own, xi, xT, xs, T, sigma, m):
+    """(xi, xi_T, xi_sigma) kept in the major loop: raised to g_M(tau_M), then lowered to g_A(tau_A).
+
+    ``own`` is the branch's own major curve at (T, sigma) (g_A heating, g_M cooling); the other
+    curve is evaluated only where a cosine-free bound does not already show that it cannot
+    bind (``kinetics.g_cooling_upper_bound``, ``g_heating_lower_bound``): the same result.
+    """
+    if d > 0:
+        if xi < g_cooling_upper_bound(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C):
+            gM = g_cooling(T, sigma, m.M_S0_C, m.M_F0_C, m.c_M_Pa_per_C)
+            if xi < gM[0]:
+                xi, xT, xs = gM
+        if xi > own[0]:
+            xi, xT, xs = own
+        return xi, xT, xs
+    if xi < own[0]:
+        xi, xT, xs = own
+    if xi > g_heating_lower_bound(T, sigma, m.A_S0_C, m.A_F0_C, m.c_A_Pa_per_C):
+        gA = g_heating(T, sigma, m.A_S0_C, m.A_F0_C, m.c_A_Pa_per_C)
+        if xi > gA[0]:
+            xi, xT, xs = gA
     return xi, xT, xs
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def drive_direction(rec, dT_dt, dsigma_dt, m):
     """Direction for ``update_memory`` from the derivatives at a sub-step start.
 
@@ -298,7 +316,7 @@ def _legacy_update(rec, T, sigma, direction, m):
                         turn, rec.reversal_C, rec.clamps, rec.merges)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def update_memory(rec, stack, depth, T, sigma, direction, m):
     """Commit the sub-step's events at (T, sigma) and choose the branch for the next one.
 

@@ -60,7 +60,7 @@ def _reached(d, tau, target_tau):
     return tau <= target_tau
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def branch_slope(x_r, g_r, x_t, g_t):
     """Slope b >= 0 of the branch through (g_r, x_r) aimed at (g_t, x_t); 0 when g_r == g_t."""
     dg = g_r - g_t
@@ -72,7 +72,7 @@ def branch_slope(x_r, g_r, x_t, g_t):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _target_point(stack, depth, d):
     """(tau, xi, g) of the target of a branch in direction d with ``depth`` rows in use."""
     if depth >= 2:
@@ -83,20 +83,20 @@ def _target_point(stack, depth, d):
     return -math.inf, 1.0, 1.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def aim(stack, depth, d, x0, g0):
     """Slope of the branch through (g0, x0) aimed at the target for ``depth`` rows."""
     _, x_t, g_t = _target_point(stack, depth, d)
     return branch_slope(x0, g0, x_t, g_t)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _resumed(stack, t):
     """The branch resumed once row t is passed: the one that reached it (x0, g0, slope)."""
     return stack[t, S_X0], stack[t, S_G0], stack[t, S_SLOPE]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def branch_target(stack, depth, d, x0, g0, slope):
     """Target (tau, xi) and parent branch (x0, g0, slope) of the current branch.
 
@@ -120,7 +120,7 @@ def _into_loop(xi, gA, gM):
     return xi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _write(stack, j, tauA, tauM, xi, gA, gM, x0, g0, slope):
     stack[j, S_TAU_A] = tauA
     stack[j, S_TAU_M] = tauM
@@ -139,7 +139,7 @@ def _unreachable(stack, t, d, x, g):
     return stack[t, _g_col(d)] == g and abs(stack[t, S_XI] - x) > LOOP_TOL
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _push(stack, depth, tauA, tauM, xi, gA, gM, d, x0, g0, slope):
     """Push a reversal point; on a full stack merge the innermost loop. Returns (depth, merged).
 
@@ -206,7 +206,7 @@ def _own(d, tauA, tauM, gA, gM):
     return tauM, gM
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def memory_update(d, x0, g0, slope, lim_tau, lim_g, clamps, merges, stack, depth, T, sigma,
                   direction, m):
     """One sub-step start of the memory rule (see the module docstring).

@@ -60,8 +60,12 @@ def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     Eqs. (3), (4a)/(5a) without the reference subtraction, (4b)/(5b).
     """
     a = theta + alpha0
-    xb = r * math.cos(a)
-    yb = r * math.sin(a)
+    return tendon_at(r * math.cos(a), r * math.sin(a), xc, yc, xd, yd, wrapped)
+
+
+@njit(cache=True, inline="always")
+def tendon_at(xb, yb, xc, yc, xd, yd, wrapped):
+    """:func:`tendon` with B = (xb, yb) given (Eq. 3)."""
     if wrapped:
         xp = xd
         yp = yd
@@ -80,9 +84,15 @@ def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
 @njit(cache=True, inline="always")
 def tendon_route(rt, theta):
     """(path, dpath/dtheta, arm) of a joint tendon, with its Configuration I/II switch."""
-    up = rt.r_m * math.sin(theta + rt.switch_alpha0_rad) >= rt.switch_y_m
+    a = theta + rt.alpha0_rad
+    sin_a = math.sin(a)
+    if rt.switch_alpha0_rad == rt.alpha0_rad:  # the upper tendon: its own B decides (one sine)
+        sin_switch = sin_a
+    else:
+        sin_switch = math.sin(theta + rt.switch_alpha0_rad)
+    up = rt.r_m * sin_switch >= rt.switch_y_m
     wrapped = up if rt.wrapped_when_up else not up
-    return tendon(theta, rt.r_m, rt.alpha0_rad, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
+    return tendon_at(rt.r_m * math.cos(a), rt.r_m * sin_a, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
 
 
 @njit(cache=True, inline="always")

@@ -57,6 +57,52 @@ def g_cooling(T, sigma, M_S0, M_F0, c_M):
     return g, dg_dT, -dg_dT / c_M
 
 
+#: added to the polynomial bounds below: far above the rounding of cos and of the polynomial
+BOUND_MARGIN = 1e-9
+
+
+@njit(cache=True, inline="always")
+def g_cooling_upper_bound(T, sigma, M_S0, M_F0, c_M):
+    """A number >= g_M of Eq. (10) as :func:`g_cooling` computes it, without a cosine.
+
+    The same branches as ``g_cooling`` (0 above M_S, 1 below M_F, the same bits); in the band
+    (1 + cos u)/2 <= 1 - u^2/4 + u^4/48 (cos u <= 1 - u^2/2 + u^4/24 for every real u), plus
+    :data:`BOUND_MARGIN`. ``xi >= g_cooling_upper_bound(...)`` proves ``xi >= g_M`` (also for
+    NaN: both comparisons are then False).
+    """
+    shift = sigma / c_M
+    M_S = M_S0 + shift
+    M_F = M_F0 + shift
+    if T >= M_S:
+        return 0.0
+    if T <= M_F:
+        return 1.0
+    u = math.pi / (M_S0 - M_F0) * (T - M_F)
+    u2 = u * u
+    return 1.0 - u2 / 4.0 + u2 * u2 / 48.0 + BOUND_MARGIN
+
+
+@njit(cache=True, inline="always")
+def g_heating_lower_bound(T, sigma, A_S0, A_F0, c_A):
+    """A number <= g_A of Eq. (9) as :func:`g_heating` computes it, without a cosine.
+
+    The same branches as ``g_heating`` (1 below A_S, 0 above A_F, the same bits); in the band
+    (1 + cos u)/2 >= 1 - u^2/4 + u^4/48 - u^6/1440 (cos u >= 1 - u^2/2 + u^4/24 - u^6/720 for
+    every real u), minus :data:`BOUND_MARGIN`. ``xi <= g_heating_lower_bound(...)`` proves
+    ``xi <= g_A``.
+    """
+    shift = sigma / c_A
+    A_S = A_S0 + shift
+    A_F = A_F0 + shift
+    if T <= A_S:
+        return 1.0
+    if T >= A_F:
+        return 0.0
+    u = math.pi / (A_F0 - A_S0) * (T - A_S)
+    u2 = u * u
+    return 1.0 - u2 / 4.0 + u2 * u2 / 48.0 - u2 * u2 * u2 / 1440.0 - BOUND_MARGIN
+
+
 @njit(cache=True, inline="always")
 def martensite_fraction(branch, start, xi_held, T, sigma, A_S0, A_F0, c_A, M_S0, M_F0, c_M):
     """xi and its partials (dxi/dT, dxi/dsigma) on a branch (Eqs. 9b, 10b).
