@@ -39,7 +39,7 @@ def _inputs(upper_branch):
     return Inputs(False, 0.03, -0.9, 1.0, False, wires)
 
 
-STATE = State(-0.5, 0.3, 0.01, (WireState(77.8, 11.7e6, 0.0, 0.0, 23.0), WireState(28.0, 7.1e6, 0.0, 0.0, 23.0)))
+STATE = State(-0.5, 0.3, 0.01, (WireState(77.8, 11.7e6, 0.0, 0.0, 23.0, 0.5), WireState(28.0, 7.1e6, 0.0, 0.0, 23.0, 1.0)))
 
 
 def test_only_the_moved_wire_is_recomputed_with_the_same_bits():
