@@ -145,6 +145,39 @@ def _next_event(s, run, segs, prog, prog_i):
     return e
 
 
+@njit(cache=True, inline="always")
+def _initial_run(model, run):
+    """(state, inputs, commands) at t = 0; with the authors' solver, their martensite functions' globals."""
+    inputs = initial_inputs(model, run.current_drive)
+    if run.method == Method.AUTHORS_ODE4:
+        inputs = authors_calls_inputs(inputs, model)
+    return initial_state(model), inputs, initial_commands(model)
+
+
+@njit(cache=True, inline="always")
+def _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl, memory, started):
+    """The closed-loop controller's tick at t (its period, every sub-step, or a segment start);
+    with the authors' solver, their PID's error rate from their Derivative block
+    (:func:`.authors.major_commands`). Returns (commands, integrating, controller state)."""
+    if started or run.update_ticks == 0 or t % run.update_ticks == 0:
+        cmds, integrating, ctl = control_tick(model.controller, ctl, model, s, y, inputs, geom, geom_q,
+                                              t * run.tick_s, started)
+        if run.pwm == PwmModel.SAMPLED:
+            cmds, integrating = major_commands(model, run, t, s, y, cmds, integrating, memory)
+    return cmds, integrating, ctl
+
+
+@njit(cache=True, inline="always")
+def _step_event(s, run, t, next_event, locate):
+    """The next event a step must end at: the scheduled one or, with long steps (``locate``), the
+    tick at which the target will count as reached if that comes first."""
+    if locate:
+        c = confirm_tick(s, run.hold_ticks)
+        if c > t and (next_event <= t or c < next_event):
+            return c
+    return next_event
+
+
 @njit(cache=True, nogil=True)
 def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reached):
     """Simulate from t = 0 to t_end; fill the output arrays (one row per output sample).
@@ -156,15 +189,10 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     is 1 and ``state`` is the state at ``t_fail_s``. No array is passed to a helper on the
     per-sub-step path (each pass costs atomic reference counting).
     """
-    y = initial_state(model)
-    inputs = initial_inputs(model, run.current_drive)
-    if run.method == Method.AUTHORS_ODE4:  # the authors' solver: their martensite functions' calls
-        inputs = authors_calls_inputs(inputs, model)
-    cmds = initial_commands(model)
+    y, inputs, cmds = _initial_run(model, run)
     ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
     s = Schedule(0, model.dynamics.q0, 0, -1, False, -1, -1, -1, False)
-    geom = geometry(model, y.q)
-    geom_q = y.q
+    geom, geom_q = geometry(model, y.q), y.q
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
     stacks = np.zeros((len(model.wires), STACK_CAPACITY, STACK_COLUMNS))  # reversal points, per wire
@@ -193,20 +221,13 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
                     prog_i += 1
                 cmds = program_commands(cmds, prog.level[prog_i - 1], prog.duty[prog_i - 1])
                 next_event = _next_event(s, run, segs, prog, prog_i)
-        elif started or run.update_ticks == 0 or t % run.update_ticks == 0:
-            cmds, integrating, ctl = control_tick(model.controller, ctl, model, s, y, inputs, geom, geom_q,
-                                                  t * run.tick_s, started)
-            if run.pwm == PwmModel.SAMPLED:  # the authors' solver: their PID's error rate
-                cmds, integrating = major_commands(model, run, t, s, y, cmds, integrating, memory)
+        else:
+            cmds, integrating, ctl = _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl,
+                                              memory, started)
         if run.pwm == PwmModel.SAMPLED:  # their Derivative block's update, after its output
             memory = DerivativeMemory(s.q_target - y.q, t)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)
-        event = next_event
-        if locate:  # long steps: one ends where the target will count as reached
-            c = confirm_tick(s, run.hold_ticks)
-            if c > t and (event <= t or c < event):
-                event = c
-        t_next = _interval_end(t, run, cmds, event)
+        t_next = _interval_end(t, run, cmds, _step_event(s, run, t, next_event, locate))
         t_start, q_start = t, y.q
         ps = (t // run.pwm_ticks) * run.pwm_ticks
         a = float(t)
