@@ -24,8 +24,19 @@ TIMEOUT_S = float(os.environ.get("SMAFINGER_FUZZ_TIMEOUT", "120"))
 TALLY: dict[str, Counter] = {}
 
 
+def _warm_kernels() -> None:
+    """Compile the engine for both mechanisms here, with no time limit: on a fresh machine the
+    first compile takes about a minute of CPU (more on a busy one), which is not a hang; the
+    worker then loads it from numba's cache."""
+    from smafinger.engine.run import make_spec, run_spec
+
+    for params, profile in (("paper2010", "0:-30"), ("linear-bias-spring", "0:0.005")):
+        run_spec(make_spec(params, "cooperative", profile, t_end_s=0.01))
+
+
 @pytest.fixture(scope="session")
 def runner(tmp_path_factory):
+    _warm_kernels()
     r = Runner(tmp_path_factory.mktemp("fuzz"), TIMEOUT_S)
     yield r
     r.close()
