@@ -225,9 +225,11 @@ class LocalPool(SerialPool):
 
         it = iter(items)
         pending: set = set()
+        undelivered = 0  # finished tasks whose outcome is not yet yielded: held here too
 
         def fill() -> None:
-            while len(pending) < IN_FLIGHT_PER_SLOT * self.slots:
+            # the bound covers every task drawn and not yet delivered, running or finished
+            while len(pending) + undelivered < IN_FLIGHT_PER_SLOT * self.slots:
                 item = next(it, _END)
                 if item is _END:
                     return
@@ -239,11 +241,13 @@ class LocalPool(SerialPool):
                 done, pending_left = wait(pending, return_when=FIRST_COMPLETED)
                 pending.clear()
                 pending.update(pending_left)
+                undelivered = len(done)
                 for f in done:
                     try:
                         res = f.result()
                     except BrokenProcessPool as exc:
                         raise BatchError(f"a worker process died ({exc}); finished runs are kept") from None
+                    undelivered -= 1
                     fill()
                     yield res
         finally:
