@@ -81,7 +81,7 @@ def chain_initial(ctrl, model):
     return ChainState(0.0, 0.0, 0.0, 0.0, False)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def law_output(ctrl, e, de, integral):
     """The law's signed DC%."""
     if ctrl.law == Law.FUZZY_PID:
@@ -92,7 +92,7 @@ def law_output(ctrl, e, de, integral):
     return pid_output(e, de, integral, g.K_P, g.K_V, g.K_I)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def chain_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
     """One tick of the chain (see the module docstring): (commands, integrating, state)."""
     m = measure(ctrl.sensors, model, s, y, inputs, geom, geom_q, t_s, started)

@@ -14,7 +14,7 @@ from .pid import pid_output, saturated_against
 from .strategies import Command, is_enabled, wire_command
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def phase_commands(model, enabled, u, q_target, q, level):
     """One signed controller output u [%] as a command per wire: the phase selection of Sec. 2.6.
 
@@ -31,14 +31,14 @@ def phase_commands(model, enabled, u, q_target, q, level):
     return cmds
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def integrating_flag(model, u, e):
     """1.0 while the error integral runs, 0.0 while anti-windup freezes it (Eq. 12a)."""
     frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)
     return 0.0 if frozen else 1.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def pid_commands(model, enabled, q_target, state, level):
     """(commands, integrating): the PID (Eq. 12a) and the phase selection of Sec. 2.6.
 
@@ -50,7 +50,7 @@ def pid_commands(model, enabled, q_target, state, level):
     return phase_commands(model, enabled, u, q_target, state.q, level), integrating_flag(model, u, e)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def pid_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
     """The paper's PWM-PID as a controller (:mod:`.interface`): no state of its own, every sensor
     exact (it reads the plant state: q, q' and the error integral)."""
@@ -63,7 +63,7 @@ def pid_initial(ctrl, model):
     return ()
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def program_commands(cmds, levels, duties):
     """Open loop: each wire at its program's level and duty (enabled while both are positive)."""
     for i in range(len(cmds)):
@@ -72,7 +72,7 @@ def program_commands(cmds, levels, duties):
     return cmds
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def viscous_coefficient(dynamics, cmds, rule):
     """C_DF: the heating value while any wire heats (or is enabled, per ``rule``; always with
     ``heating-value``), else the cooling value."""

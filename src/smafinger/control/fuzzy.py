@@ -64,7 +64,7 @@ class Gains(NamedTuple):
     K_I: float
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def membership(x, k):
     """Membership of the scaled input x in set k (triangular; the outer sets saturate)."""
     c = _CENTRES[k]
@@ -103,7 +103,7 @@ def scheduled_gains(ctrl, e, de):
     return Gains(K_P, K_V, K_P * K_P / (alpha * K_V) if K_V > 0.0 else 0.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def fuzzy_output(ctrl, e, de, integral):
     """DC% of the scheduled PID (Eq. 12a with the gains of :func:`scheduled_gains`)."""
     g = scheduled_gains(ctrl, e, de)

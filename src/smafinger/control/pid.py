@@ -13,31 +13,31 @@ opposite sign (the paper's antagonist, -DC%).
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def pid_output(error, error_rate, error_integral, K_P, K_V, K_I):
     """Unclamped controller output DC% of Eq. (12a)."""
     return K_P * error + K_V * error_rate + K_I * error_integral
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def clamp_duty(u):
     """DC% clamped to [0, 100]."""
     return min(max(u, 0.0), 100.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def saturated_against(u, error):
     """Anti-windup (conditional integration): the output is saturated and the error pushes it further."""
     return (u >= 100.0 and error > 0.0) or (u <= -100.0 and error < 0.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def on_time(duty_percent, t_P):
     """t_DC = t_P DC% / 100 of Eq. (12b) (in the unit of t_P)."""
     return duty_percent / 100.0 * t_P
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def pwm_edge(period_start, duty_percent, t_P):
     """The falling edge of a PWM period (Eq. 12b), or -1 when the duty is 0 or 100 % (no edge)."""
     if 0.0 < duty_percent < 100.0:
@@ -45,7 +45,7 @@ def pwm_edge(period_start, duty_percent, t_P):
     return -1.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def pwm_output(level, low, duty_percent, on, t_in_period):
     """The drive at time ``t_in_period`` into the PWM period (Fig. 6): ``level`` while on, ``low`` after."""
     if duty_percent >= 100.0 or (duty_percent > 0.0 and t_in_period < on):

@@ -43,7 +43,7 @@ class RapidHeating(NamedTuple):
     preheat_duty: float  #: DC% of the pre-heating [%]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _opposing_idle(wires, cmds, i):
     """No wire pulling against wire i has a duty."""
     for k in range(len(wires)):
@@ -52,7 +52,7 @@ def _opposing_idle(wires, cmds, i):
     return True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def shape_commands(ctrl, model, cmds, m):
     """Rapid heating, the temperature limit and pre-heating, applied to the core's commands.
 

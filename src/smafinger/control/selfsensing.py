@@ -36,7 +36,7 @@ class ResistanceMap(NamedTuple):
     rate_tau_s: float
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def estimate(rmap, R):
     """q_hat of Eq. (S1) from the resistances R (a per-wire tuple)."""
     q = rmap.c0
@@ -46,7 +46,7 @@ def estimate(rmap, R):
     return q
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def filtered_rate(rmap, v_prev, q_hat, q_prev, dt):
     """v_hat of Eq. (S2) (0 on the first tick: ``dt <= 0``)."""
     if dt <= 0.0:

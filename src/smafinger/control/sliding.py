@@ -32,19 +32,19 @@ class SlidingMode(NamedTuple):
     K: float  #: switching gain [%]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def surface(ctrl, e, de, integral):
     """s of Eq. (SM1) [q/s]."""
     return de + ctrl.lam * e + ctrl.lam_I * integral
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def switching(ctrl, s):
     """DC% of Eq. (SM2) (signed; the phase selection clamps it per wire)."""
     return ctrl.K * min(max(s / ctrl.phi, -1.0), 1.0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def sliding_output(ctrl, e, de, integral):
     """DC% of Eqs. (SM1)-(SM2)."""
     return switching(ctrl, surface(ctrl, e, de, integral))

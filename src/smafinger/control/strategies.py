@@ -78,7 +78,7 @@ def is_enabled(mask, i):
     return (mask >> i) & 1 == 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def heating_phase(direction, q_target, q):
     """Sec. 2.6: the wire's heating phase (upper: theta_F >= theta; lower: theta_F <= theta)."""
     if direction > 0.0:
@@ -86,7 +86,7 @@ def heating_phase(direction, q_target, q):
     return q_target <= q
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_command(u, enabled, direction, q_target, q, keep_on_in_cooling, level):
     """One wire's :class:`Command` from the PID output u [%]."""
     if not enabled:
@@ -108,7 +108,7 @@ def agonist_of(wires, q_target, q, previous):
     return NO_WIRE
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def opposing_wires_driven(wires, drives, low):
     """The interlock: two wires pulling opposite ways both driven above V_L."""
     up = False

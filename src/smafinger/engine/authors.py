@@ -68,7 +68,7 @@ class DerivativeMemory(NamedTuple):
 NO_MAJOR_STEP = DerivativeMemory(0.0, -1)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def derivative_block(error, error_last, dt):
     """A Simulink ``Derivative`` block's output: (u - u_last) / (t - t_last).
 
@@ -105,7 +105,7 @@ def _pid_at_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rat
     return impl
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def major_commands(model, run, t, s, y, cmds, integrating, memory):
     """(commands, integrating) at a control tick ``t`` (a major step): the PID's with the error
     rate of the Derivative block (:func:`derivative_block`) against the previous major step
@@ -117,7 +117,7 @@ def major_commands(model, run, t, s, y, cmds, integrating, memory):
     return pid_at_rate(model.controller, model, s.enabled, s.q_target, y, cmds, integrating, rate)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stage_inputs(model, inputs, y, st, phase, since):
     """``inputs`` with each wire's drive and heating phase at stage state ``y``, ``since`` s
     after the major step, ``phase`` s into the PWM period.
@@ -140,7 +140,7 @@ def stage_inputs(model, inputs, y, st, phase, since):
     return with_field(inputs, "wires", wis)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def call_branches(model, y, inputs):
     """``inputs`` with each wire's branch for an evaluation at state ``y``: the authors' call
     (rule ``AUTHORS_CALLS``) takes the sign of its own dT/dt (Eq. 11 at the evaluation's drive
@@ -157,7 +157,7 @@ def call_branches(model, y, inputs):
     return with_field(inputs, "wires", wis)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def commit_calls(model, y, inputs, aux):
     """``inputs`` with the authors' globals after the evaluation at ``y`` that gave ``aux``
     (each wire's xi and stress there; rule ``AUTHORS_CALLS`` only)."""

@@ -15,13 +15,13 @@ from ..model.records import Aux, State, WireAux, WireState
 from .tuples import filled, set_item
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def zero_aux(wires):
     """An :class:`~smafinger.model.records.Aux` of zeros for ``wires`` (a typed placeholder)."""
     return Aux(0.0, filled(wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _mix(a, b, w):
     return a + w * (b - a)
 
@@ -39,7 +39,7 @@ def _wire_aux(a, b, w):
                    _mix(a.spring_m, b.spring_m, w), _mix(a.arm_m, b.arm_m, w), _mix(a.dT_C_s, b.dT_C_s, w))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def interpolated(y0, aux0, y1, aux1, w):
     """(state, aux) a fraction ``w`` in [0, 1] of the way from (y0, aux0) to (y1, aux1)."""
     ws = y0.wires

@@ -74,7 +74,7 @@ def _wire_axpy(a, c, b):
                      a.heat_J + c * b.heat_J, a.T_case_C + c * b.T_case_C, a.xi_integrated + c * b.xi_integrated)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def axpy(y, c, k):
     """y + c k, field by field."""
     ws = y.wires
@@ -83,7 +83,7 @@ def axpy(y, c, k):
     return State(y.q + c * k.q, y.v + c * k.v, y.error_integral + c * k.error_integral, ws)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def phi1(z):
     """(e^z - 1) / z, 1 at z = 0 (exponential integrators)."""
     if abs(z) < 1e-5:
@@ -91,7 +91,7 @@ def phi1(z):
     return math.expm1(z) / z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def phi2(z):
     """(e^z - 1 - z) / z^2, 1/2 at z = 0."""
     if abs(z) < 1e-3:
@@ -99,7 +99,7 @@ def phi2(z):
     return (math.expm1(z) - z) / (z * z)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _damped_mechanism(method, y, k1, h, c):
     """(q, v) after h with the viscous damping c = C_DF / I treated implicitly or exactly.
 
@@ -114,7 +114,7 @@ def _damped_mechanism(method, y, k1, h, c):
     return y.q + h * k1.q + h * h * phi2(z) * k1.v, y.v + h * phi1(z) * k1.v
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def step(method, model, y, h, inputs, k1, geom, stages):
     """y advanced by h (see the module docstring for the methods). Returns (y, evaluations, inputs).
 

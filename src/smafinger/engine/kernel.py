@@ -62,7 +62,7 @@ class Program(NamedTuple):
     duty: object  #: float64[n, n_wires]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _interval_end(t, run, cmds, next_event):
     """End of the interval that starts at tick t: the next step, PWM period, sample, update or event."""
     ps = (t // run.pwm_ticks) * run.pwm_ticks
@@ -79,7 +79,7 @@ def _interval_end(t, run, cmds, next_event):
     return t_next
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _sub_bounds(t, t_next, ps, cmds, run, bounds):
     """Fill ``bounds`` with the sub-step ends in (t, t_next]: the PWM duty edges (exact PWM), then t_next."""
     nb = 0
@@ -102,7 +102,7 @@ def _sub_bounds(t, t_next, ps, cmds, run, bounds):
     return nb + 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _flush(mo, wo, out_i, next_out, run, wires, a, final, prev, now):
     """Write the output samples due before sub-step start ``a`` (and at ``a`` on the final pass).
 
@@ -125,7 +125,7 @@ def _flush(mo, wo, out_i, next_out, run, wires, a, final, prev, now):
     return out_i, next_out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _segment_due(s, t, seg_start):
     """A segment starts at t (its time has come, or its predecessor's target was reached)."""
     if s.next_seg >= len(seg_start):
@@ -145,7 +145,7 @@ def _next_event(s, run, segs, prog, prog_i):
     return e
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _initial_run(model, run):
     """(state, inputs, commands) at t = 0; with the authors' solver, their martensite functions' globals."""
     inputs = initial_inputs(model, run.current_drive)
@@ -154,7 +154,7 @@ def _initial_run(model, run):
     return initial_state(model), inputs, initial_commands(model)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl, memory, started):
     """The closed-loop controller's tick at t (its period, every sub-step, or a segment start);
     with the authors' solver, their PID's error rate from their Derivative block
@@ -167,7 +167,7 @@ def _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl, 
     return cmds, integrating, ctl
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _step_event(s, run, t, next_event, locate):
     """The next event a step must end at: the scheduled one or, with long steps (``locate``), the
     tick at which the target will count as reached if that comes first."""

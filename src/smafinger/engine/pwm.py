@@ -62,7 +62,7 @@ def get(name: str) -> PwmModel:
         raise ValueError(f"pwm = {name!r} is not one of {', '.join(PWM_MODELS)}") from None
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def averaged_drive(level, low, duty_percent):
     """The drive whose square is the PWM wave's mean square over a period (Eq. 12b, Eq. 11)."""
     if duty_percent >= 100.0:
@@ -73,7 +73,7 @@ def averaged_drive(level, low, duty_percent):
     return math.sqrt(d * level * level + (1.0 - d) * low * low)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def sampled_drive(level, low, duty_percent, on, phase):
     """The PWM wave read at ``phase`` into its period as the authors' model reads it (``<=`` t_DC).
 
@@ -83,7 +83,7 @@ def sampled_drive(level, low, duty_percent, on, phase):
     return low
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _solver_time(ticks, dt_ticks):
     """A fixed-step solver's time at ``ticks``: n h for the step's n-th end, as Simulink counts it."""
     if ticks % dt_ticks == 0:
@@ -91,13 +91,13 @@ def _solver_time(ticks, dt_ticks):
     return ticks / TICKS_PER_S
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _advanced(t, t_ref, period):
     """The authors' ``if (time - tRef) >= periodDC, tRef = time``."""
     return t if t - t_ref >= period else t_ref
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def sampled_phases(a, b, dt_ticks, pwm_ticks, t_ref):
     """(phase at the first stage, at the two middle ones, at the last [s], reference time after).
 

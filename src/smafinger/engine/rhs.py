@@ -28,7 +28,7 @@ class Geometry(NamedTuple):
     external: float  #: the mechanism's load apart from the wires (gravity, bias spring)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def geometry(model, q):
     """:class:`Geometry` at coordinate q (Eqs. 3-6 and the external load of Eq. 1b)."""
     w = model.wires
@@ -39,7 +39,7 @@ def geometry(model, q):
     return Geometry(routes, c, external_load(model.dynamics.load, q, c))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def geometry_at(q, q_prev, geom_prev, model):
     """geometry(model, q), reusing ``geom_prev`` (that of ``q_prev``) if q is unchanged (same bits)."""
     if q == q_prev:
@@ -47,7 +47,7 @@ def geometry_at(q, q_prev, geom_prev, model):
     return geometry(model, q)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _wire_terms(model, state, inputs, geom, i):
     wire = model.wires[i]
     ws = state.wires[i]
@@ -61,7 +61,7 @@ def _wire_terms(model, state, inputs, geom, i):
     return rate, aux, wire_load(sigma, wire.area_m2, rt.dpath_dq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def derivative(state, inputs, model, geom):
     """(dstate/dt, aux): the derivative of the state and the algebraic quantities (loads, xi, sigma)."""
     rates = filled(state.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
@@ -75,7 +75,7 @@ def derivative(state, inputs, model, geom):
     return _with_mechanism(state, inputs, model, geom, rates, auxs, load)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def derivative_redone(state, inputs, model, geom, prev, redo):
     """:func:`derivative` where only the wires flagged in ``redo`` (a tuple of bools) may differ
     from ``prev`` = (dstate/dt, aux) at the same state and geometry: their terms are computed
@@ -96,7 +96,7 @@ def derivative_redone(state, inputs, model, geom, prev, redo):
     return _with_mechanism(state, inputs, model, geom, rates, auxs, load)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _with_mechanism(state, inputs, model, geom, rates, auxs, load):
     """The derivative from the wires' rates and summed load: the mechanism's rates (Eqs. 1-2, 12a)."""
     load += geom.external  # Eq. (1b): wires first, then gravity (or the bias spring)

@@ -90,7 +90,7 @@ def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs
     return s, started
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def track_reach(s, t, q, tol, hold_ticks, t_prev, q_prev, locate):
     """Track whether the current target has been entered for good (within ``tol`` for ``hold_ticks``).
 
@@ -118,7 +118,7 @@ def track_reach(s, t, q, tol, hold_ticks, t_prev, q_prev, locate):
     return with_field(s, "band_since", -1), -1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def confirm_tick(s, hold_ticks):
     """The tick at which the current target will count as reached if q stays in the band (-1: none)."""
     if s.band_since >= 0 and not s.confirmed:

@@ -114,7 +114,7 @@ def kernel_views(mech: np.ndarray, wires: np.ndarray) -> tuple[np.ndarray, np.nd
             wires.view(np.float64).reshape(wires.shape[0], wires.shape[1], len(WIRE_FIELDS)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives, wires, geom):
     """Write output sample ``i``: every signal, by its column (a test checks none is left NaN).
 

@@ -87,14 +87,14 @@ def initial_commands(model):
     return filled(model.wires, Command(False, False, 0.0, model.drive.V_H_V))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _branch_moved(a, b):
     """Did a memory update change how xi is evaluated (not only the extreme reached so far)?"""
     return not (a.direction == b.direction and a.x0 == b.x0 and a.g0 == b.g0 and a.slope == b.slope
                 and a.target_tau == b.target_tau and a.parent_slope == b.parent_slope)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _any(flags):
     """True if any item of the tuple of bools ``flags`` is."""
     out = False
@@ -103,7 +103,7 @@ def _any(flags):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _update_kinetics(model, y, inputs, k1, aux, stacks):
     """Each wire's kinetics branch for the sub-step, from the derivatives at its start (Eqs. 9-10).
 
@@ -124,7 +124,7 @@ def _update_kinetics(model, y, inputs, k1, aux, stacks):
     return with_field(inputs, "wires", wis), moved
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _drive(run, c, low, phase):
     """A wire's drive under command ``c`` at ``phase`` ticks into the PWM period (:mod:`.pwm`).
 
@@ -139,13 +139,13 @@ def _drive(run, c, low, phase):
     return pwm_output(c.level, low, c.duty, on_time(c.duty, run.pwm_ticks), phase)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _low(model, run):
     """The drive between PWM pulses: V_L, or 0 A with a current drive."""
     return 0.0 if run.current_drive else model.drive.V_L_V
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, phase, stuck):
     """(inputs, drives, interlock drives) for a sub-step; ``phase``: where the drive is read.
 
@@ -168,7 +168,7 @@ def _held_inputs(model, run, y, inputs, geom, cmds, s, viscous, integrating, pha
     return Inputs(stuck, viscous, s.q_target, integrating, run.current_drive, wis), drives, resolved, low
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _after_step(model, y, stuck):
     """Post-step constraints: a tendon cannot push (rate law), a stuck mechanism is at rest, end stops."""
     ws = y.wires
@@ -181,7 +181,7 @@ def _after_step(model, y, stuck):
     return State(q, v, y.error_integral, ws)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _xi_restarted(y, aux):
     """y with each wire's ``xi_integrated`` restarted at its xi (the sub-step start's, ``aux``)."""
     ws = y.wires
@@ -190,7 +190,7 @@ def _xi_restarted(y, aux):
     return State(y.q, y.v, y.error_integral, ws)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _xi_caught_up(model, y, inputs):
     """y with each wire's stress caught up with its transformation over the sub-step (rate law,
     :func:`~smafinger.model.wire.transformation_catch_up`)."""
@@ -203,7 +203,7 @@ def _xi_caught_up(model, y, inputs):
     return State(y.q, y.v, y.error_integral, ws)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _finite(y):
     ok = math.isfinite(y.q) and math.isfinite(y.v) and math.isfinite(y.error_integral)
     for w in y.wires:
@@ -212,7 +212,7 @@ def _finite(y):
     return ok
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a, b, phase, first, stuck, v_prev,
            counters, stacks):
     """The discrete decisions at the start of sub-step [a, b] (ticks): drives, interlock, kinetics
@@ -266,7 +266,7 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
     return y, inputs, geom, geom_q, stuck, y.v, with_field(counters, "evals", evals), k1, aux, drives
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end, error_major):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints.
 

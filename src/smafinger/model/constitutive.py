@@ -17,13 +17,13 @@ import math
 from numba import njit
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def youngs_modulus(xi, D_A, D_M):
     """D = D_A + xi (D_M - D_A) (Eq. 7a)."""
     return D_A + xi * (D_M - D_A)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def spring_stiffness(x, K_S, x_limit, fact):
     """K_s,eff [N/m] at spring elongation x [m]; stiffening beyond x_limit (dx in mm)."""
     dx_mm = 1000.0 * (x - x_limit)
@@ -44,7 +44,7 @@ def spring_force(x, K_S, x_limit, fact):
     return K_S * x + (math.sinh(u) - u) / (1000.0 * fact)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def spring_elongation(F, K_S, x_limit, fact):
     """Inverse of :func:`spring_force` (F >= 0).
 
@@ -100,14 +100,14 @@ def _spring_elongation_bracketed(F, K_S, x_limit, fact):
     return x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def equivalent_modulus(K_s, D, S_w, L_w):
     """D_eq = K_eq L_w / S_w with K_eq = K_s K_D / (K_s + K_D) (Eq. 8) [Pa]."""
     K_D = D * S_w / L_w
     return K_s * K_D / (K_s + K_D) * L_w / S_w
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stress_rate(D_eq, deps_dt, eps_R, dxi_dT, dxi_dsigma, dT_dt, sigma):
     """dsigma/dt of Eq. (7b), solved together with dxi/dt = xi_T T' + xi_sigma sigma'.
 
@@ -133,7 +133,7 @@ def secant_modulus_authors(eps_el, D, K_S, x_limit, fact, S_w, L_w):
     return equivalent_modulus(K_s, D, S_w, L_w), x_spring
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def rate_law_modulus(wire, sigma, D):
     """(D_eq, spring elongation) of Eq. (8) for the rate law at stress sigma.
 
@@ -148,7 +148,7 @@ def rate_law_modulus(wire, sigma, D):
     return equivalent_modulus(K_s, D, wire.area_m2, wire.wire_length_m), x_s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def secant_modulus(wire, eps_el, D):
     """(D_eq, spring elongation) of the algebraic law at elastic strain eps_el (wire + spring)."""
     if wire.series_rigid:

@@ -36,13 +36,13 @@ class SliderLoad(NamedTuple):
     external_force_N: float
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def gravity_moment(load, cos_theta):
     """-m g d_CM cos(theta): gravity's moment about the joint [N m] (Eq. 1b)."""
     return -(load.gravity_moment_Nm * cos_theta)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def bias_force(load, x):
     """Force of the bias spring and the constant load on the slider at x [N] (negative: against the wire)."""
     return -(load.bias_spring_preload_N + load.bias_spring_K_N_m * x + load.external_force_N)
@@ -68,13 +68,13 @@ def mechanism_load(load, q, cos_q):
     return external_load(load, q, cos_q)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_load(sigma, area, dpath_dq):
     """A wire's generalized force -F dpath/dq with F = sigma S_w (Eq. 1b)."""
     return sigma * area * (-dpath_dq)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def sliding_friction(omega, M_DF, C_DF):
     """M_Fr [N m] of Eq. (2) while sliding."""
     if omega > 0.0:
@@ -84,7 +84,7 @@ def sliding_friction(omega, M_DF, C_DF):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def angular_acceleration(M_E, omega, stuck, I, M_DF, C_DF):
     """q'' of Eq. (1a) (theta'' [rad/s^2] for the joint)."""
     if stuck:
@@ -92,7 +92,7 @@ def angular_acceleration(M_E, omega, stuck, I, M_DF, C_DF):
     return (M_E - sliding_friction(omega, M_DF, C_DF)) / I
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def stick_slip(stuck, first, load, v, v_prev, dyn, restick):
     """Eq. (2) as a discrete decision at a sub-step start: is the mechanism held?
 
@@ -110,7 +110,7 @@ def stick_slip(stuck, first, load, v, v_prev, dyn, restick):
     return False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def end_stop(q, v, dyn):
     """(q, v) after a step, clamped to the end stops [q_min, q_max] (a stop absorbs the motion)."""
     if q > dyn.q_max:
@@ -120,7 +120,7 @@ def end_stop(q, v, dyn):
     return q, v
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def at_stop_holding(q, load, dyn):
     """True while the mechanism rests on a stop and its load pushes it into the stop."""
     return (q >= dyn.q_max and load > 0.0) or (q <= dyn.q_min and load < 0.0)

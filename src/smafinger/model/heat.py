@@ -26,13 +26,13 @@ STEFAN_BOLTZMANN_W_m2K4 = 5.670374419e-8
 KELVIN = 273.15
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def convection_coefficient(T, h0, h2):
     """h = h0 + h2 T^2 [W/(m^2 K)] (Eq. 11), T in degC as in the paper."""
     return h0 + h2 * T * T
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def joule_power_per_m(wire, drive, current_drive, reading):
     """P' [W/m]: electrical power per metre of wire for a voltage (or current) ``drive``."""
     if current_drive:
@@ -42,7 +42,7 @@ def joule_power_per_m(wire, drive, current_drive, reading):
     return drive * drive / (wire.resistance_ohm_per_m * wire.wire_length_m * wire.wire_length_m)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def electrical_power(wire, drive, current_drive):
     """Power at the wire's terminals [W]: V^2 / (R_w L_w) or I^2 R_w L_w."""
     if current_drive:
@@ -50,13 +50,13 @@ def electrical_power(wire, drive, current_drive):
     return drive * drive / wire.resistance_ohm
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def heat_balance(T, P, h, T_amb, M_w, C_p, A_w):
     """dT/dt [degC/s] of Eq. (11) for power P' [W/m] and coefficient h."""
     return (P - h * A_w * (T - T_amb)) / (M_w * C_p)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_h(wire, T, heating):
     """h of Eq. (11) with the heating or cooling coefficients of the wire's phase (Sec. 3.2)."""
     if heating:
@@ -64,13 +64,13 @@ def wire_h(wire, T, heating):
     return convection_coefficient(T, wire.h0_cooling_W_m2K, wire.h2_cooling_W_m2K3)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def surroundings_C(wire, T_case, model):
     """The temperature the wire loses heat to: the ambient (Eq. 11) or the casing air (two-node)."""
     return T_case if model == ThermalModel.TWO_NODE else wire.T_amb_C
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_temperature_rate(wire, T, T_case, drive, heating, current_drive, opts):
     """Eq. (11) for a wire, with the heating or cooling coefficients of its phase (no latent heat)."""
     h = wire_h(wire, T, heating)
@@ -79,7 +79,7 @@ def wire_temperature_rate(wire, T, T_case, drive, heating, current_drive, opts):
     return heat_balance(T, P, h, T_sur, wire.mass_per_length_kg_m, wire.specific_heat_J_kgK, wire.perimeter_m)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def radiation_per_m(wire, T, T_sur):
     """Radiative loss per metre [W/m] added to Eq. (11): eps sigma_SB A_w (T^4 - T_sur^4), kelvin inside.
 
@@ -95,7 +95,7 @@ def radiation_per_m(wire, T, T_sur):
     return eps * STEFAN_BOLTZMANN_W_m2K4 * wire.perimeter_m * (Tk ** 4 - Sk ** 4)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def casing_temperature_rate(wire, T, T_case, heating, opts):
     """dT_case/dt of the two-node model: C_case dT_case/dt = h A_w (T - T_case) - G (T_case - T_amb).
 
@@ -111,7 +111,7 @@ def casing_temperature_rate(wire, T, T_case, heating, opts):
     return (q_in - q_out) / wire.casing_heat_capacity_J_mK
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def latent_heat_rate(dT_no_latent, dsigma_free, dsigma_dT, xi_T, xi_s, wire):
     """dT/dt with the latent heat of the transformation (Eq. 11 plus M_w dH dxi/dt).
 

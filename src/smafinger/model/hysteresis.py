@@ -192,7 +192,7 @@ def initial_record(rule, xi_init, T_init, reversal_C):
     return rec, 0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def xi_on_branch(rec, T, sigma, m):
     """xi and its partial derivatives (dxi/dT, dxi/dsigma) on the record's branch.
 
@@ -240,7 +240,7 @@ def xi_on_branch(rec, T, sigma, m):
     return _into_major_loop(d, own, x0 + b * (g - g0), b * gT, b * gs, T, sigma, m)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _into_major_loop(d, own, xi, xT, xs, T, sigma, m):
     """(xi, xi_T, xi_sigma) kept in the major loop: raised to g_M(tau_M), then lowered to g_A(tau_A).
 
@@ -265,7 +265,7 @@ def _into_major_loop(d, own, xi, xT, xs, T, sigma, m):
     return xi, xT, xs
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def drive_direction(rec, dT_dt, dsigma_dt, m):
     """Direction for ``update_memory`` from the derivatives at a sub-step start.
 
@@ -316,7 +316,7 @@ def _legacy_update(rec, T, sigma, direction, m):
                         turn, rec.reversal_C, rec.clamps, rec.merges)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def update_memory(rec, stack, depth, T, sigma, direction, m):
     """Commit the sub-step's events at (T, sigma) and choose the branch for the next one.
 

@@ -43,13 +43,13 @@ from .kinetics import COOLING, HEATING, branch_start
 RAW = False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def globals_of(rec):
     """(Es, Ef, Esave): the authors' three globals of one wire, kept in its branch record."""
     return rec.parent_x0, rec.parent_slope, rec.target_xi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _record(phase, Es, Ef, Esave):
     """The record of a call with branch ``phase`` (+1, -1, 0) and the globals (Es, Ef, Esave):
     heating xi = Es g_A, cooling xi = Ef + (1 - Ef) g_M (Eqs. 9b, 10b), hold xi = Esave."""
@@ -69,7 +69,7 @@ def initial_calls_record(xi_init):
     return _record(0, xi_init, 0.0, xi_init)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def call_record(rec, dT_dt):
     """The record a call evaluates with: its branch from the sign of its dT/dt, the globals kept."""
     Es, Ef, Esave = globals_of(rec)

@@ -42,17 +42,17 @@ STACK_COLUMNS = 8
 LOOP_TOL = 1e-12  # a committed excursion out of the major loop beyond this is clamped and counted
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _tau_col(d):
     return S_TAU_A if d > 0 else S_TAU_M
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _g_col(d):
     return S_G_A if d > 0 else S_G_M
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _reached(d, tau, target_tau):
     """True once tau has reached the target in direction d (heating: rising, cooling: falling)."""
     if d > 0:
@@ -60,7 +60,7 @@ def _reached(d, tau, target_tau):
     return tau <= target_tau
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def branch_slope(x_r, g_r, x_t, g_t):
     """Slope b >= 0 of the branch through (g_r, x_r) aimed at (g_t, x_t); 0 when g_r == g_t."""
     dg = g_r - g_t
@@ -72,7 +72,7 @@ def branch_slope(x_r, g_r, x_t, g_t):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _target_point(stack, depth, d):
     """(tau, xi, g) of the target of a branch in direction d with ``depth`` rows in use."""
     if depth >= 2:
@@ -83,20 +83,20 @@ def _target_point(stack, depth, d):
     return -math.inf, 1.0, 1.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def aim(stack, depth, d, x0, g0):
     """Slope of the branch through (g0, x0) aimed at the target for ``depth`` rows."""
     _, x_t, g_t = _target_point(stack, depth, d)
     return branch_slope(x0, g0, x_t, g_t)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _resumed(stack, t):
     """The branch resumed once row t is passed: the one that reached it (x0, g0, slope)."""
     return stack[t, S_X0], stack[t, S_G0], stack[t, S_SLOPE]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def branch_target(stack, depth, d, x0, g0, slope):
     """Target (tau, xi) and parent branch (x0, g0, slope) of the current branch.
 
@@ -110,7 +110,7 @@ def branch_target(stack, depth, d, x0, g0, slope):
     return tau, x_t, px0, pg0, pb
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _into_loop(xi, gA, gM):
     """min(max(xi, g_M), g_A): xi clamped to the major loop (g_A if the loop is empty)."""
     if xi < gM:
@@ -120,7 +120,7 @@ def _into_loop(xi, gA, gM):
     return xi
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _write(stack, j, tauA, tauM, xi, gA, gM, x0, g0, slope):
     stack[j, S_TAU_A] = tauA
     stack[j, S_TAU_M] = tauM
@@ -132,14 +132,14 @@ def _write(stack, j, tauA, tauM, xi, gA, gM, x0, g0, slope):
     stack[j, S_SLOPE] = slope
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _unreachable(stack, t, d, x, g):
     """True if a branch in direction d through (g, x) cannot end at row t: the same g but
     another xi (possible only after a merge; a loop the branch could not close)."""
     return stack[t, _g_col(d)] == g and abs(stack[t, S_XI] - x) > LOOP_TOL
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _push(stack, depth, tauA, tauM, xi, gA, gM, d, x0, g0, slope):
     """Push a reversal point; on a full stack merge the innermost loop. Returns (depth, merged).
 
@@ -198,7 +198,7 @@ def _no_history(stack, xi, T, sigma, gA, gM, m):
     return -1, xi, gM, branch_slope(xi, gM, 1.0, 1.0), 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def _own(d, tauA, tauM, gA, gM):
     """(tau, g) of the branch direction d: (tau_A, g_A) heating, (tau_M, g_M) cooling."""
     if d > 0:
@@ -206,7 +206,7 @@ def _own(d, tauA, tauM, gA, gM):
     return tauM, gM
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def memory_update(d, x0, g0, slope, lim_tau, lim_g, clamps, merges, stack, depth, T, sigma,
                   direction, m):
     """One sub-step start of the memory rule (see the module docstring).

@@ -53,7 +53,7 @@ class DirectPull(NamedTuple):
     dpath_dq: float  #: -1: the path shortens as the slider moves in the pulling direction
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     """:class:`WireGeometry` of one tendon: path length [m], d(path)/d(theta) [m/rad], moment arm b [m].
 
@@ -63,7 +63,7 @@ def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
     return tendon_at(r * math.cos(a), r * math.sin(a), xc, yc, xd, yd, wrapped)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def tendon_at(xb, yb, xc, yc, xd, yd, wrapped):
     """:func:`tendon` with B = (xb, yb) given (Eq. 3)."""
     if wrapped:
@@ -81,7 +81,7 @@ def tendon_at(xb, yb, xc, yc, xd, yd, wrapped):
     return WireGeometry(fixed + dpb, dpath, arm)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def tendon_route(rt, theta):
     """(path, dpath/dtheta, arm) of a joint tendon, with its Configuration I/II switch."""
     a = theta + rt.alpha0_rad
@@ -95,7 +95,7 @@ def tendon_route(rt, theta):
     return tendon_at(rt.r_m * math.cos(a), rt.r_m * sin_a, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def direct_pull(rt, x):
     """(path, dpath/dx, arm) of a wire pulling a slider: path = -x from the start."""
     return WireGeometry(rt.dpath_dq * x, rt.dpath_dq, 1.0)

@@ -23,7 +23,7 @@ HEATING = 1
 COOLING = 2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def g_heating(T, sigma, A_S0, A_F0, c_A):
     """g_A and its partial derivatives (d/dT, d/dsigma) of Eq. (9)."""
     shift = sigma / c_A
@@ -40,7 +40,7 @@ def g_heating(T, sigma, A_S0, A_F0, c_A):
     return g, dg_dT, -dg_dT / c_A
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def g_cooling(T, sigma, M_S0, M_F0, c_M):
     """g_M and its partial derivatives (d/dT, d/dsigma) of Eq. (10)."""
     shift = sigma / c_M
@@ -61,7 +61,7 @@ def g_cooling(T, sigma, M_S0, M_F0, c_M):
 BOUND_MARGIN = 1e-9
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def g_cooling_upper_bound(T, sigma, M_S0, M_F0, c_M):
     """A number >= g_M of Eq. (10) as :func:`g_cooling` computes it, without a cosine.
 
@@ -82,7 +82,7 @@ def g_cooling_upper_bound(T, sigma, M_S0, M_F0, c_M):
     return 1.0 - u2 / 4.0 + u2 * u2 / 48.0 + BOUND_MARGIN
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def g_heating_lower_bound(T, sigma, A_S0, A_F0, c_A):
     """A number <= g_A of Eq. (9) as :func:`g_heating` computes it, without a cosine.
 
@@ -103,7 +103,7 @@ def g_heating_lower_bound(T, sigma, A_S0, A_F0, c_A):
     return 1.0 - u2 / 4.0 + u2 * u2 / 48.0 - u2 * u2 * u2 / 1440.0 - BOUND_MARGIN
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def martensite_fraction(branch, start, xi_held, T, sigma, A_S0, A_F0, c_A, M_S0, M_F0, c_M):
     """xi and its partials (dxi/dT, dxi/dsigma) on a branch (Eqs. 9b, 10b).
 

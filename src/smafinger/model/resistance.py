@@ -34,7 +34,7 @@ from .hysteresis import xi_on_branch
 from .wire import algebraic_stress, total_strain
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def resistivity(wire, T_C, xi):
     """rho(xi, T) of Eq. (R1) [ohm m]."""
     dT = T_C - wire.resistivity_reference_C
@@ -43,14 +43,14 @@ def resistivity(wire, T_C, xi):
     return xi * rho_M + (1.0 - xi) * rho_A
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_strain(wire, path, spring_m):
     """The wire's own strain from its austenite length at tendon path ``path`` and spring
     elongation ``spring_m`` (see the module docstring); the initial one is eps_total0 less x_0 / L_w."""
     return wire.eps_total0 + (path - wire.path0_m - spring_m) / wire.wire_length_m
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_resistance(wire, T_C, xi, strain):
     """The whole wire's resistance R [ohm] of Eq. (R2) at temperature, martensite fraction and strain."""
     stretch = 1.0 + strain

@@ -80,13 +80,13 @@ def algebraic_stress(wire, eps_total, T, branch):
     return sigma, xi, x_s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def total_strain(wire, path):
     """Total strain of wire + spring at path length ``path`` (Eq. 6), for the algebraic law."""
     return wire.eps_total0 + (path - wire.path0_m) / wire.wire_length_m
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_stress_xi(wire, ws, branch, path, stress_law):
     """(sigma, xi) of a wire at its state: the state's stress (rate law) or the solved one."""
     if stress_law == StressLaw.ALGEBRAIC:
@@ -95,7 +95,7 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
     return ws.sigma_Pa, xi_on_branch(branch, ws.T_C, ws.sigma_Pa, wire)[0]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
     """A wire's (dT/dt, dsigma/dt, dT_case/dt, dxi/dt) and (sigma, xi, spring elongation).
 
@@ -125,7 +125,7 @@ def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
     return dT, dsigma, dTc, xT * dT + xs * dsigma, sigma, xi, x_s
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, forceinline=True)
 def transformation_catch_up(wire, ws, branch):
     """Eq. (7b) over a sub-step: (sigma, xi_integrated) once the stress has taken the sub-step's
     whole transformation increment.
