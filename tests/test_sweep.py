@@ -17,6 +17,7 @@ import pytest
 from smafinger.analysis import sweep as sw
 from smafinger.analysis.sweep import (SweepInterrupted, SweepSizeError, SweepSpecError, load_spec, parse_spec,
                                      run_sweep)
+from smafinger.analysis.sweep_spec import canonical_run
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG8 = ROOT / "examples" / "sweep-fig8.toml"
@@ -75,6 +76,20 @@ def test_grid_list_and_run_ids(tmp_path):
     lin = parse_spec({"base": {"t_end_s": 1.0, "profile": "0:-30"},
                       "vary": {"M_SF_Nm": {"start": 1e-3, "stop": 1e-1, "num": 3, "log": True}}})
     assert np.allclose([p["M_SF_Nm"] for p in lin.points()], [1e-3, 1e-2, 1e-1])
+
+
+def test_the_pwm_model_is_a_run_setting_with_its_own_run_id():
+    """A sweep may set or vary ``pwm`` (the long-step settings need ``averaged``); the default
+    leaves the canonical spec, and so the run ids of earlier sweeps, as they were."""
+    spec = parse_spec({"base": {"t_end_s": 1.0, "profile": "0:-30", "method": "exponential", "dt_s": 0.005},
+                       "vary": {"pwm": {"values": ["exact", "averaged"]}}})
+    exact, averaged = spec.runs()
+    assert exact.spec.pwm == "exact" and averaged.spec.pwm == "averaged"
+    assert exact.run_id != averaged.run_id
+    assert "pwm" not in canonical_run(exact.spec) and canonical_run(averaged.spec)["pwm"] == "averaged"
+    with pytest.raises(SweepSpecError, match="pwm"):
+        parse_spec({"base": {"t_end_s": 1.0, "profile": "0:-30", "pwm": "smooth"},
+                    "vary": {"tol_deg": {"values": [0.5]}}}).runs()
 
 
 def test_random_and_lhs_sampling_seeded():

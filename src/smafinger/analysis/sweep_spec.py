@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from ..engine.defaults import DEFAULT_PWM
 from ..engine.run import RunSpec, make_spec
 from ..parameters import ParameterError, ParameterSet, resolve
 from ..profiles import ProfileError
@@ -31,7 +32,7 @@ MODES = ("grid", "list", "random", "lhs")
 RUN_KEYS = {
     "params": str, "strategy": str, "profile": str, "voltage": str, "t_end_s": float,
     "dt_s": float, "method": str, "output_interval_s": float, "tol_deg": float,
-    "hold_s": float, "independent_wait": bool,
+    "hold_s": float, "independent_wait": bool, "pwm": str,
 }
 #: sweeps with more runs are refused before anything is made (``--max-runs`` raises it)
 DEFAULT_MAX_RUNS = 1_000_000
@@ -79,6 +80,8 @@ def canonical_run(spec: RunSpec) -> dict:
         "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method,
         "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg,
         "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
+        # the PWM model only when it is not the default: the run ids of earlier sweeps stay valid
+        **({} if spec.pwm == DEFAULT_PWM else {"pwm": spec.pwm}),
     }
 
 
