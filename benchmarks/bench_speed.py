@@ -3,9 +3,13 @@
 For each case, in one process, measured interleaved (so that load from elsewhere hits every
 setting alike) and printed as ratios:
 
-- ``today``: the engine's default (rk4, 1 ms, the PWM resolved at its edges), the baseline;
-- ``fast``: the long-step setting (exponential integrator, 5 ms, PWM averaged over its
+- ``reference``: rk4, 1 ms, the PWM resolved at its edges: the engine's default before the
+  long-step default, what the paper's scenarios use, and the baseline of the ratios;
+- ``long``: the long-step setting (exponential integrator, 5 ms, PWM averaged over its
   period, reach events located inside steps) and a few neighbours;
+- ``(default)`` marks the setting a run of the case gets when it sets none of ``dt_s``,
+  ``method``, ``pwm`` (``engine.numerics``: the long step for ``paper2010``, the reference for
+  the linear rig and ``authors2020``);
 - the error of each against a reference run (rk4, 1 us, exact PWM edges): RMS and max of the
   coordinate on the output grid, and the reach times.
 
@@ -14,14 +18,16 @@ Cases: the paper's co-operative full cycle (Fig. 15, -40 -> -25 -> -55 -> -40 de
 the authors' 2020 profile 2 (``authors2020``, independent, 20 s). Then the authors' solver
 (``authors-ode4``): the peak wire temperatures of their profiles 1 and 2 against their plots.
 
-Then the legacy engine (commit ff21ad0, before the engine redesign) as recorded on this kind
-of machine, the SciPy baseline (the test oracle's ``solve_ivp``, open loop: it has no
+Then the legacy engine (smafinger 0.1, commit ff21ad0, before the engine redesign): with
+``--legacy-src PATH`` (its ``src`` folder, e.g. from ``git worktree add /tmp/old ff21ad0``)
+measured here, interleaved with this engine, on the full cycle (CPU time of the whole
+``run_spec`` call, best of the repeats); without it, as recorded on this kind of machine; the SciPy baseline (the test oracle's ``solve_ivp``, open loop: it has no
 controller), and the process-level times: ``smafinger --help``, a cached ``simulate`` (whole
 process) and, with ``--cold``, the first result after a fresh install (an empty numba cache).
 
 Usage::
 
-    PYTHONPATH=src python benchmarks/bench_speed.py [--repeat 7] [--ref-dt 1e-6] [--cold]
+    PYTHONPATH=src python benchmarks/bench_speed.py [--repeat 7] [--ref-dt 1e-6] [--cold] [--legacy-src PATH]
 
 Goals (issue 11): full cycle <= 2 ms engine loop at <= 0.05 deg RMS and <= 0.3 deg max error;
 ``--help`` <= 0.3 s; cached ``simulate`` process <= 1 s; first result <= 10 s.
@@ -56,14 +62,14 @@ CASES = (
     ("linear bias-spring rig, closed loop", "linear-bias-spring", "cooperative", "0:0.010,15:0.004", 30.0),
     ("authors2020 profile 2", "authors2020", "independent", "0:-25:upper,5:-55:both", 20.0),
 )
-TODAY = ("rk4", 1e-3, "exact")
-FAST = ("exponential", 5e-3, "averaged")
+TODAY = ("rk4", 1e-3, "exact")  # the reference numerics (engine.numerics.REFERENCE)
+FAST = ("exponential", 5e-3, "averaged")  # the long step (engine.numerics.LONG_STEP)
 SETTINGS = (TODAY, FAST, ("semi-implicit", 5e-3, "averaged"), ("exponential", 1e-2, "averaged"),
             ("rk4", 1e-3, "averaged"))
 
-#: the legacy engine (commit ff21ad0), co-operative full cycle at rk4 / 1 ms, measured on this kind
-#: of machine (2 cores) interleaved with the redesigned engine before this work (issue 11's text)
-LEGACY = {"kernel_ms": (29.0, 31.0), "rms_deg": 0.0056, "substeps": 83260}
+#: the legacy engine (commit ff21ad0), co-operative full cycle at rk4 / 1 ms, CPU time of run_spec,
+#: measured on this kind of machine (2 cores) interleaved with this engine (--legacy-src)
+LEGACY = {"kernel_ms": (15.2, 15.7), "rms_deg": 0.0056, "substeps": 83260}
 
 
 def _spec(params, strategy, profile, t_end, setting):
@@ -102,27 +108,69 @@ def bench_case(label, params, strategy, profile, t_end, repeat, ref_dt) -> dict:
     print(f"   reference: rk4 {ref_dt * 1e6:g} us, exact PWM ({ref.substeps} sub-steps, {t_ref:.0f} s); "
           f"reached {_reached(ref)}")
     base = min(walls[TODAY])
+    default = make_spec(params, strategy, profile, t_end_s=t_end)
+    default = (default.method, default.dt_s, default.pwm)
     out = {}
     for s in SETTINGS:
         r = results[s]
         rms, mx = _errors(r, ref)
         best, med = min(walls[s]), statistics.median(walls[s])
-        tag = "today" if s == TODAY else ("fast " if s == FAST else "     ")
+        tag = ("reference" if s == TODAY else ("long     " if s == FAST else "         ")) + \
+            (" (default)" if s == default else "          ")
         print(f"   {tag} {s[0]:13s} {s[1] * 1e3:4g} ms {s[2]:8s}: kernel {best * 1e3:7.2f} ms (median {med * 1e3:7.2f}), "
-              f"{r.substeps:6d} sub-steps, RATIO today/this {base / best:5.1f}x; "
+              f"{r.substeps:6d} sub-steps, RATIO reference/this {base / best:5.1f}x; "
               f"error RMS {rms:.4f} {unit}, max {mx:.4f} {unit}; reached {_reached(r)}")
         out[s] = {"best_s": best, "rms": rms, "max": mx}
     return out
 
 
-def bench_legacy(paper: dict) -> None:
-    fast, today = paper[FAST], paper[TODAY]
-    lo, hi = LEGACY["kernel_ms"]
-    print(f"\n== legacy engine (ff21ad0, recorded): co-operative full cycle rk4 1 ms: {lo:g}-{hi:g} ms, "
-          f"{LEGACY['rms_deg']} deg RMS ({LEGACY['substeps']} sub-steps)")
-    print(f"   RATIO legacy/fast {lo / (fast['best_s'] * 1e3):.1f}-{hi / (fast['best_s'] * 1e3):.1f}x, "
-          f"legacy/today {lo / (today['best_s'] * 1e3):.2f}-{hi / (today['best_s'] * 1e3):.2f}x "
-          "(recorded numbers, not measured in this run: compare with care under load)")
+#: one full cycle in a child process: CPU time of run_spec, best of N (argv: N, then NAME=VALUE
+#: numerics; the legacy engine's make_spec takes the same names, and no pwm)
+_CYCLE_CPU = """
+import sys, time
+from smafinger.engine.run import make_spec, run_spec
+kw = {k: (float(v) if k == "dt_s" else v) for k, v in (a.split("=") for a in sys.argv[2:])}
+spec = make_spec("paper2010", "cooperative", "0:-25,reach:-55,reach:-40", t_end_s=45.0, **kw)
+run_spec(spec)
+best = float("inf")
+for _ in range(int(sys.argv[1])):
+    t0 = time.thread_time()
+    run_spec(spec)
+    best = min(best, time.thread_time() - t0)
+print(best * 1e3)
+"""
+
+
+def _cycle_cpu_ms(src: Path, repeat: int, *numerics: str) -> float:
+    env = dict(os.environ, PYTHONPATH=str(src))
+    out = subprocess.run([sys.executable, "-c", _CYCLE_CPU, str(repeat), *numerics], env=env, check=True,
+                         capture_output=True, text=True).stdout
+    return float(out.strip().splitlines()[-1])
+
+
+def bench_legacy(paper: dict, legacy_src: Path | None, repeat: int) -> None:
+    if legacy_src is None:
+        fast, today = paper[FAST], paper[TODAY]
+        lo, hi = LEGACY["kernel_ms"]
+        print(f"\n== legacy engine (ff21ad0, recorded): co-operative full cycle rk4 1 ms: {lo:g}-{hi:g} ms, "
+              f"{LEGACY['rms_deg']} deg RMS ({LEGACY['substeps']} sub-steps)")
+        print(f"   RATIO legacy/long {lo / (fast['best_s'] * 1e3):.1f}-{hi / (fast['best_s'] * 1e3):.1f}x, "
+              f"legacy/reference {lo / (today['best_s'] * 1e3):.2f}-{hi / (today['best_s'] * 1e3):.2f}x "
+              "(recorded numbers, not measured in this run: --legacy-src measures them)")
+        return
+    rows = {"legacy (ff21ad0) default: rk4 1 ms": (legacy_src,),
+            "this engine, default (long step)": (SRC,),
+            "this engine, reference: rk4 1 ms exact": (SRC, "dt_s=0.001")}
+    times: dict = {k: [] for k in rows}
+    for _ in range(3):  # interleaved rounds, each a fresh process per engine
+        for k, (src, *numerics) in rows.items():
+            times[k].append(_cycle_cpu_ms(src, repeat, *numerics))
+    legacy = min(times[next(iter(rows))])
+    print(f"\n== legacy engine measured here: co-operative full cycle, CPU of run_spec, best of {repeat} in each "
+          "of 3 interleaved rounds")
+    for k, ts in times.items():
+        print(f"   {k:40s}: {min(ts):7.2f} ms (rounds {', '.join(f'{t:.2f}' for t in ts)}), "
+              f"RATIO legacy/this {legacy / min(ts):5.2f}x")
 
 
 def bench_scipy(repeat: int) -> None:
@@ -196,10 +244,12 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--ref-dt", type=float, default=1e-6, help="reference step [s] (1e-6: minutes per case)")
     ap.add_argument("--cold", action="store_true", help="also time a run with an empty numba cache")
+    ap.add_argument("--legacy-src", type=Path, default=None,
+                    help="src folder of smafinger 0.1 (commit ff21ad0) to measure it side by side")
     args = ap.parse_args()
     print(f"bench_speed: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} (1 min)")
     results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
-    bench_legacy(results[CASES[0][0]])
+    bench_legacy(results[CASES[0][0]], args.legacy_src, args.repeat)
     bench_scipy(args.repeat)
     bench_authors()
     bench_process(args.cold)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from smafinger.bench.gym_env import PlantSession, make_env
+from smafinger.bench.runner import BENCH_NUMERICS
 from smafinger.engine.run import make_spec, run_spec
 from smafinger.profiles import VoltageProgram
 
@@ -17,7 +18,9 @@ def test_stepping_equals_one_open_loop_run_bit_for_bit():
         obs = s.step(d)
     assert s.done and s.t_s == pytest.approx(1.0)
     prog = VoltageProgram(tuple((0.2 * k, *d) for k, d in enumerate(duties)), "duty")
-    r = run_spec(make_spec("paper2010", "open-loop", voltage=prog, t_end_s=1.0, output_interval_s=0.2))
+    # the plant runs at the bench's numerics (the reference ones), as the bench's controllers do
+    r = run_spec(make_spec("paper2010", "open-loop", voltage=prog, t_end_s=1.0, output_interval_s=0.2,
+                           **BENCH_NUMERICS))
     expected = [r.signal("theta_deg")[-1], r.signal("omega_deg_s")[-1], r.signal("R_upper_ohm")[-1],
                 r.signal("R_lower_ohm")[-1], -30.0]
     np.testing.assert_array_equal(obs, np.array(expected))

@@ -36,7 +36,8 @@ def test_eq11_constant_h_matches_closed_form():
     # independent hand numbers: 64/8.6 W/m over h pi d; tau = rho S C_p / (h pi d)
     assert T_ss == pytest.approx(23 + (64 / 8.6) / (h * math.pi * 0.375e-3), rel=1e-12)
     assert tau == pytest.approx(6450 * 322 * 0.375e-3 / 4 / h, rel=1e-12)
-    r = simulate(p, "open-loop", voltage="0:8:0", t_end_s=8 * tau // 1e-3 * 1e-3)
+    # RK4 (4th order: the closed form to 1e-6), not the long-step default (1st order in the wire)
+    r = simulate(p, "open-loop", voltage="0:8:0", t_end_s=8 * tau // 1e-3 * 1e-3, method="rk4")
     t = r.t
     exact = T_ss + (p.T_init_C - T_ss) * np.exp(-t / tau)
     assert np.max(np.abs(r.T_upper_C - exact)) < 1e-6

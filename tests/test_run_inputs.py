@@ -82,10 +82,10 @@ def test_the_limit_is_half_the_memory_and_is_applied(monkeypatch):
     (dict(profile=[(0, -25)]), "profile = [(0, -25)] is not a profile text"),
     (dict(tol_deg="0.5"), "tol_deg = '0.5' is not a number"),
     (dict(t_end_s=True), "t_end_s = True is not a number"),
-    (dict(dt_s=None), "dt_s = None is not a number"),
+    (dict(dt_s="1e-3"), "dt_s = '1e-3' is not a number"),
     (dict(hold_s=np.bool_(True)), "hold_s = "),
     (dict(strategy=3), "strategy = 3 is not one of"),
-    (dict(method=None), "method = None is not one of"),
+    (dict(method=4), "method = 4 is not one of"),
     (dict(params=42), "params = 42 is not a set's name"),
     (dict(independent_wait="yes"), "independent_wait = 'yes' is not True or False"),
 ])

@@ -20,15 +20,20 @@ from pathlib import Path
 from .sweep_spec import RUN_ID_SCHEMA
 
 
-def run_settings(run_kw: dict) -> dict:
-    """The base run settings with make_spec's defaults filled in, as JSON values."""
+def run_settings(run_kw: dict, params) -> dict:
+    """The base run settings with make_spec's defaults filled in (the numerics as they resolve
+    for ``params``, :mod:`smafinger.engine.numerics`), as JSON values."""
+    from ..engine.numerics import choose
     from ..engine.run import make_spec
     from ..profiles import TargetProfile, VoltageProgram
     from ..provenance import program_text
 
     defaults = {k: v.default for k, v in inspect.signature(make_spec).parameters.items() if k != "params"}
+    given = {**defaults, **run_kw}
+    n = choose(params, given["controller"], given["t_end_s"], given["method"], given["dt_s"], given["pwm"])
+    given.update(method=n.method, dt_s=n.dt_s, pwm=n.pwm)
     out = {}
-    for k, v in {**defaults, **run_kw}.items():
+    for k, v in given.items():
         if isinstance(v, TargetProfile):
             v = v.to_text()
         elif isinstance(v, VoltageProgram):
@@ -45,7 +50,7 @@ def sweep_provenance(template) -> dict:
     return {
         "smafinger_version": __version__,
         "base_parameters": {"mechanism": template.params.mechanism, **template.params.to_dict()},
-        "base_run_settings": run_settings(template.run_kw),
+        "base_run_settings": run_settings(template.run_kw, template.params),
         "run_id": f"first 16 hex digits of the SHA-256 of the run's canonical definition (schema {RUN_ID_SCHEMA})",
     }
 

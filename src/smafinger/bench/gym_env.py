@@ -30,6 +30,7 @@ from ..engine.run import make_spec, run_spec
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
 from ..profiles import VoltageProgram
+from .runner import BENCH_NUMERICS
 
 
 class PlantSession:
@@ -83,7 +84,7 @@ class PlantSession:
                 raise ValueError(f"duty of wire {w} = {float(x)!r} must be in [0, 1]")
         self.steps.append((self.t_s, *map(float, d)))
         spec = make_spec(self.params, "open-loop", voltage=VoltageProgram(tuple(self.steps), "duty"),
-                         t_end_s=self.t_s, output_interval_s=self.dt)
+                         t_end_s=self.t_s, output_interval_s=self.dt, **BENCH_NUMERICS)
         self.result = run_spec(spec)
         return self.observe()
 
@@ -95,7 +96,7 @@ class PlantSession:
         if self.result is None:  # the initial state: the first sample of any run (zero duty here)
             zero = VoltageProgram(((0.0,) + (0.0,) * len(self.wires),), "duty")
             probe = run_spec(make_spec(self.params, "open-loop", voltage=zero, t_end_s=self.dt,
-                                       output_interval_s=self.dt))
+                                       output_interval_s=self.dt, **BENCH_NUMERICS))
             first = {n: float(probe.signal(n)[0]) for n in probe.column_names}
             get = first.__getitem__
             rate = 0.0

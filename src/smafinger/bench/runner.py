@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Callable, Sequence
 
 import pandas as pd
 
 from ..engine.batch import run_batch
+from ..engine.defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM
 from ..engine.run import make_spec
 from .presets import BENCH_CONTROLLERS, bench_controller
 from .scores import RunRecord, bandwidth_hz, record_of, task_scores
@@ -23,6 +25,9 @@ from .tasks import Task
 STRATEGIES = ("independent", "cooperative")
 #: the bench samples its runs this often [s] (reach times are decided by the engine at every step)
 OUTPUT_S = 0.01
+#: every controller runs at the reference numerics (engine.numerics), whatever a run's default:
+#: the laws were tuned and are scored on the resolved PWM, and all compare on the same numerics
+BENCH_NUMERICS = MappingProxyType({"dt_s": DEFAULT_DT_S, "method": DEFAULT_METHOD, "pwm": DEFAULT_PWM})
 
 
 @dataclass
@@ -44,7 +49,7 @@ def bench_specs(tasks: Sequence[Task], controllers: dict, strategies: Sequence[s
                 continue
             for strategy in strategies:
                 spec = make_spec(p, strategy, task.profile, t_end_s=task.t_end_s, output_interval_s=OUTPUT_S,
-                                 controller=ctrl)
+                                 controller=ctrl, **BENCH_NUMERICS)
                 out.append(((task.mechanism, task.name, label, strategy), spec))
     return out
 

@@ -32,7 +32,7 @@ from ..control.params import CONTROLLERS, ControllerParameters, PaperPID
 from ..engine.batch import make_pool, run_batch
 from ..model.build import build_model
 from ..parameters import ParameterError, ParameterSet
-from .runner import OUTPUT_S, warm_kernels
+from .runner import BENCH_NUMERICS, OUTPUT_S, warm_kernels
 from .scores import record_of, task_scores
 from .tasks import Task
 
@@ -151,7 +151,8 @@ def objective(tasks: Sequence[Task], scores: Sequence[dict], reference: Sequence
 def _specs(tasks, controllers, strategy) -> list:
     from ..engine.run import make_spec
 
-    return [make_spec(t.params(), strategy, t.profile, t_end_s=t.t_end_s, output_interval_s=OUTPUT_S, controller=c)
+    return [make_spec(t.params(), strategy, t.profile, t_end_s=t.t_end_s, output_interval_s=OUTPUT_S, controller=c,
+                      **BENCH_NUMERICS)
             for c in controllers for t in tasks]
 
 

@@ -10,7 +10,8 @@ before ``smafinger --help`` could print. They are listed here as plain names;
 from __future__ import annotations
 
 # the engine's defaults and identification's: one copy, in a module that loads no numba
-from ..engine.defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM,  # noqa: F401
+from ..engine.defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, LONG_STEP_DT_S,  # noqa: F401
+                               LONG_STEP_METHOD, LONG_STEP_PWM,
                                DEFAULT_TOL_M, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED)
 
 #: control strategies (``control.strategies.STRATEGIES``)

@@ -91,13 +91,14 @@ def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strateg
               output_interval_s: float = 0.01) -> ResistanceCalibration:
     """Steps from rest to each target (user unit; default :data:`CALIBRATION_TARGETS`) with the paper's
     PID and a position sensor, and the fit of Eq. (S1) to the settled samples."""
-    from ..engine.run import simulate
+    from ..engine.run import DEFAULT_DT_S, simulate
 
     targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else targets
     coord = f"{p.coordinate.name}_{p.coordinate.unit}"
     qs, Rs, R_ref = [], [], None
     for target in targets:
-        r = simulate(p, strategy, f"0:{target:g}", t_end_s=STEP_S, output_interval_s=output_interval_s)
+        r = simulate(p, strategy, f"0:{target:g}", t_end_s=STEP_S, output_interval_s=output_interval_s,
+                     dt_s=DEFAULT_DT_S)  # the reference numerics (engine.numerics): the PWM resolved
         R = np.column_stack([r.signal(f"R_{w}_ohm") for w in p.wire_names])
         R_ref = R[0] if R_ref is None else R_ref
         keep = r.t >= SETTLE_S

@@ -3,6 +3,8 @@
 :mod:`.run` and the commands (:mod:`smafinger.cli`) both read them from here.
 """
 
+# The reference numerics: what a run gets when it sets any of dt_s, method, pwm (the unset ones
+# come from here), and what the paper's scenarios use (the golden record holds their bits).
 #: integration step [s]
 DEFAULT_DT_S = 1e-3
 #: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
@@ -13,6 +15,14 @@ DEFAULT_METHOD = "rk4"
 DEFAULT_OUTPUT_S = 1e-3
 #: the PWM resolved at its edges (engine.pwm); "averaged" allows long steps (docs/speed.md)
 DEFAULT_PWM = "exact"
+
+# The long-step numerics: what a run that sets none of dt_s, method, pwm gets where they were
+# validated (engine.numerics.long_step_refusal): the full co-operative cycle 16x faster than the
+# reference, 0.013 deg RMS from a 1 us run (benchmarks/bench_speed.py, docs/speed.md).
+LONG_STEP_DT_S = 5e-3
+LONG_STEP_METHOD = "exponential"
+LONG_STEP_PWM = "averaged"
+
 #: default target tolerance of the linear actuator [m]
 DEFAULT_TOL_M = 5e-4
 

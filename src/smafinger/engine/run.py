@@ -19,7 +19,7 @@ from ..parameters import ParameterSet, resolve
 from ..progress import Display
 from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
-from . import integrators, pwm as pwm_models
+from . import integrators, numerics, pwm as pwm_models
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
@@ -59,24 +59,22 @@ class RunSpec:
 
 
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
-              t_end_s=20.0, dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S,
+              t_end_s=20.0, dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S,
               tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage",
-              pwm=DEFAULT_PWM, controller=None) -> RunSpec:
+              pwm=None, controller=None) -> RunSpec:
     """A validated :class:`RunSpec` (see :func:`simulate` for the arguments).
 
     Raises ``TypeError`` for an argument of the wrong type and ``ValueError`` (or its
     subclasses ``ParameterError``, ``ProfileError``) for a bad value, in one line naming the
     argument and the value.
     """
+    given = {k: v for k, v in (("dt_s", dt_s), ("method", method), ("pwm", pwm)) if v is not None}
     _check_types(params=params, strategy=strategy, profile=profile, voltage=voltage, t_end_s=t_end_s,
-                 dt_s=dt_s, method=method, output_interval_s=output_interval_s, tol_deg=tol_deg,
-                 hold_s=hold_s, independent_wait=independent_wait, tol_m=tol_m, drive=drive, pwm=pwm)
+                 output_interval_s=output_interval_s, tol_deg=tol_deg, hold_s=hold_s,
+                 independent_wait=independent_wait, tol_m=tol_m, drive=drive, **given)
     p = resolve(params)
     if strategy not in STRATEGIES:
         raise ValueError(f"strategy = {strategy!r} is not one of {', '.join(STRATEGIES)}")
-    pwm_model = pwm_models.get(pwm)
-    if integrators.get(method).pwm_sampled and pwm_model != pwm_models.PwmModel.EXACT:
-        raise ValueError(f"pwm = {pwm!r} does not apply to method = {method!r}, which reads the PWM at its stages")
     if isinstance(profile, str):
         profile = TargetProfile.parse(profile)
     if isinstance(voltage, str):
@@ -99,6 +97,10 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
         controller = controller_from(controller).prepared(p)
         if strategy == "open-loop":
             raise ProfileError(f"a controller ({controller.label}) is only used in closed loop, not with open-loop")
+    dt_s, method, pwm = _numerics(p, controller, t_end_s, method, dt_s, pwm)
+    pwm_model = pwm_models.get(pwm)
+    if integrators.get(method).pwm_sampled and pwm_model != pwm_models.PwmModel.EXACT:
+        raise ValueError(f"pwm = {pwm!r} does not apply to method = {method!r}, which reads the PWM at its stages")
     spec = RunSpec(p, strategy, profile, voltage, float(t_end_s), float(dt_s), method,
                    float(output_interval_s), float(tol_deg), float(hold_s), bool(independent_wait), float(tol_m),
                    pwm, controller)
@@ -118,6 +120,12 @@ _ARG_TYPES = {
     "pwm": ((str,), f"one of {', '.join(pwm_models.PWM_MODELS)}"),
     "independent_wait": ((bool, np.bool_), "True or False"),
 }
+
+
+def _numerics(p, controller, t_end_s, method, dt_s, pwm) -> tuple:
+    """(dt_s, method, pwm): those given, else the run's default (:mod:`.numerics`)."""
+    n = numerics.choose(p, controller, t_end_s, method, dt_s, pwm)
+    return n.dt_s, n.method, n.pwm
 
 
 def _check_types(**args) -> None:
@@ -328,9 +336,9 @@ def _run_with_progress(call, mech, t_end_s, progress):
 
 
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
-             dt_s=DEFAULT_DT_S, method=DEFAULT_METHOD, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
+             dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
              hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
-             pwm=DEFAULT_PWM, controller=None):
+             pwm=None, controller=None):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
@@ -348,15 +356,18 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     drive : {"voltage", "duty", "current"}
         How a text ``voltage`` program is read: volts, fractions of the supply V_H (switched at
         the PWM period), or amperes.
-    t_end_s, dt_s, output_interval_s : float
-        Simulated time, step and output sampling interval [s] (whole nanoseconds).
-    method : {"rk4", "euler", "semi-implicit", "exponential", "authors-ode4"}
-        Fixed-step integrator (default :data:`DEFAULT_METHOD`, rk4; :mod:`.integrators`).
-        ``authors-ode4`` is the authors' Simulink solver: RK4 with the PWM read at its stages.
-    pwm : {"exact", "averaged"}
-        How the PWM drive is applied (:mod:`.pwm`): resolved at its edges (default), or its
-        period-averaged power (valid when the PWM period is far below the wire's thermal
-        time constant; allows steps of several PWM periods, docs/speed.md).
+    t_end_s, output_interval_s : float
+        Simulated time and output sampling interval [s] (whole nanoseconds).
+    dt_s, method, pwm : optional
+        The numerics: integration step [s]; fixed-step integrator (``"rk4"``, ``"euler"``,
+        ``"semi-implicit"``, ``"exponential"``, ``"authors-ode4"``: the authors' Simulink
+        solver, RK4 with the PWM read at its stages; :mod:`.integrators`); the PWM drive
+        resolved at its edges (``"exact"``) or its period-averaged power (``"averaged"``,
+        valid when the PWM period is far below the wire's thermal time constant; :mod:`.pwm`).
+        None of them given: the long-step settings (exponential, 5 ms, averaged) where they
+        were validated (the finger joint with the memory rule and the set's PID), else rk4,
+        1 ms, exact (:mod:`.numerics`, docs/speed.md). Any of them given: the others from
+        rk4, 1 ms, exact.
     tol_deg, tol_m, hold_s : float
         A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
         actuator) for ``hold_s``.

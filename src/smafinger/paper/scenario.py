@@ -65,17 +65,22 @@ class Scenario:
         """The scenario's parameter set, with its own overrides and then ``overrides``."""
         return self.overrides.then(Overrides.coerce(overrides)).apply(get_params(self.params))
 
-    def spec(self, overrides: Overrides | Iterable[str] = (), dt_s: float = DEFAULT_DT_S,
-             method: str = DEFAULT_METHOD, output_interval_s: float = DEFAULT_OUTPUT_S,
+    def spec(self, overrides: Overrides | Iterable[str] = (), dt_s: float | None = None,
+             method: str | None = None, output_interval_s: float = DEFAULT_OUTPUT_S,
              tol_deg: float | None = None, hold_s: float | None = None, *, profile: str | None = None,
              t_end_s: float | None = None, independent_wait: bool | None = None,
-             strategy: str | None = None, pwm: str = DEFAULT_PWM) -> RunSpec:
+             strategy: str | None = None, pwm: str | None = None) -> RunSpec:
         """A validated :class:`~smafinger.engine.run.RunSpec` of this scenario.
 
         ``overrides`` (an :class:`Overrides` or ``NAME=VALUE`` strings) apply after the
         scenario's own; the other arguments replace the scenario's run settings (``None``:
-        the scenario's, or the engine's default).
+        the scenario's, or the engine's default). The paper's scenarios run at the reference
+        numerics (rk4, 1 ms, exact PWM: their figures show the PWM-resolved temperatures and the
+        golden record holds their bits), not at a run's long-step default.
         """
+        dt_s = DEFAULT_DT_S if dt_s is None else dt_s
+        method = DEFAULT_METHOD if method is None else method
+        pwm = DEFAULT_PWM if pwm is None else pwm
         given = dict(profile=profile, t_end_s=t_end_s, independent_wait=independent_wait,
                      strategy=strategy, tol_deg=tol_deg, hold_s=hold_s)
         ov = (self.overrides.then(Overrides.coerce(overrides))

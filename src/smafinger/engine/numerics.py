@@ -1,0 +1,63 @@
+"""A run's numerical settings (integrator, step, PWM model): the ones given, or the run's default.
+
+A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets the long-step settings
+(exponential Euler, 5 ms, period-averaged PWM) where they were validated against a 1 us run
+with exact PWM edges, and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
+run that sets any of the three gets the reference values for the others, as before the
+long-step default existed. Where the long step holds and why it does not elsewhere:
+docs/speed.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..parameters.options import Hysteresis, StressLaw
+from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
+                       LONG_STEP_PWM)
+
+
+@dataclass(frozen=True)
+class Numerics:
+    method: str
+    dt_s: float
+    pwm: str
+
+
+REFERENCE = Numerics(DEFAULT_METHOD, DEFAULT_DT_S, DEFAULT_PWM)
+LONG_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
+
+
+def long_step_refusal(params, controller, t_end_s: float) -> str | None:
+    """Why the long-step settings are not this run's default (None: they are).
+
+    Validated (benchmarks/bench_speed.py; every paper2010 scenario within 0.08 deg RMS of a
+    0.1 ms RK4 run, the full cycle 0.013 deg): the finger joint, the rate-form stress law, the
+    return-point-memory hysteresis and the paper's PWM-PID (``controller`` None or ``pid``, a
+    prepared :class:`~smafinger.control.params.ControllerParameters`), with a PWM period no
+    longer than the step (the average then covers whole periods).
+    """
+    opts = params.options
+    if not t_end_s >= LONG_STEP_DT_S:
+        return f"t_end_s = {t_end_s:g} is shorter than the long step ({LONG_STEP_DT_S:g} s)"
+    if params.mechanism != "joint":
+        return f"mechanism {params.mechanism}: the wire pulls the load directly, a mode only short steps resolve"
+    if opts.stress_law != StressLaw.RATE:
+        return "the algebraic stress law has not been validated at long steps"
+    if opts.hysteresis != Hysteresis.MEMORY:
+        return f"hysteresis {opts.hysteresis.label}: its branch follows the PWM ripple the average removes"
+    if controller is not None and controller.label != "pid":
+        return f"controller {controller.label}: validated for the paper's PWM-PID only"
+    if params.pwm_period_s > LONG_STEP_DT_S:
+        return f"pwm_period_s = {params.pwm_period_s:g} is longer than the long step ({LONG_STEP_DT_S:g} s)"
+    return None
+
+
+def choose(params, controller, t_end_s: float, method: str | None, dt_s: float | None,
+           pwm: str | None) -> Numerics:
+    """The run's numerics: the given values, else the run's default (module docstring)."""
+    if method is None and dt_s is None and pwm is None:
+        return LONG_STEP if long_step_refusal(params, controller, t_end_s) is None else REFERENCE
+    return Numerics(REFERENCE.method if method is None else method,
+                    REFERENCE.dt_s if dt_s is None else dt_s,
+                    REFERENCE.pwm if pwm is None else pwm)
