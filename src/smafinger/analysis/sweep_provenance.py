@@ -30,7 +30,10 @@ def run_settings(run_kw: dict, params) -> dict:
 
     defaults = {k: v.default for k, v in inspect.signature(make_spec).parameters.items() if k != "params"}
     given = {**defaults, **run_kw}
-    n = choose(params, given["controller"], given["t_end_s"], given["method"], given["dt_s"], given["pwm"])
+    program = given["voltage"]
+    if isinstance(program, str):
+        program = VoltageProgram.parse(program, given["drive"])
+    n = choose(params, given["controller"], given["t_end_s"], given["method"], given["dt_s"], given["pwm"], program)
     given.update(method=n.method, dt_s=n.dt_s, pwm=n.pwm)
     out = {}
     for k, v in given.items():

@@ -2,7 +2,8 @@
 
 A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets the long-step settings
 (exponential Euler, 5 ms, period-averaged PWM) where they were validated against a 1 us run
-with exact PWM edges, and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
+with exact PWM edges (closed loop, and open loop under a program switched at most every 0.5 s),
+and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
 run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where the long step holds and why it does not elsewhere:
 docs/speed.md.
@@ -12,9 +13,18 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..parameters.options import Hysteresis, StressLaw
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
                        LONG_STEP_PWM)
+
+#: an open-loop drive program with two steps closer than this keeps the reference [s]: the long
+#: step's first-order wire update drifts with every switch. An 80 % square wave at 8 V for 8 s
+#: against rk4 at 0.1 ms: steps 1.6/0.4 s apart 0.021 deg RMS, 0.4/0.1 s 0.031, 0.08/0.02 s 0.12,
+#: 8/2 ms 3.5 (rk4 at 1 ms: 0.001-0.008). Set above the largest gap measured to drift, as the
+#: drift grows with the number of switches (docs/speed.md).
+PROGRAM_MIN_STEP_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -28,14 +38,16 @@ REFERENCE = Numerics(DEFAULT_METHOD, DEFAULT_DT_S, DEFAULT_PWM)
 LONG_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
 
 
-def long_step_refusal(params, controller, t_end_s: float) -> str | None:
+def long_step_refusal(params, controller, t_end_s: float, program=None) -> str | None:
     """Why the long-step settings are not this run's default (None: they are).
 
     Validated (benchmarks/bench_speed.py; every paper2010 scenario within 0.08 deg RMS of a
     0.1 ms RK4 run, the full cycle 0.013 deg): the finger joint, the rate-form stress law, the
     return-point-memory hysteresis and the paper's PWM-PID (``controller`` None or ``pid``, a
     prepared :class:`~smafinger.control.params.ControllerParameters`), with a PWM period no
-    longer than the step (the average then covers whole periods).
+    longer than the step (the average then covers whole periods), and an open-loop ``program``
+    (:class:`~smafinger.profiles.VoltageProgram`) whose steps are :data:`PROGRAM_MIN_STEP_S`
+    apart or more.
     """
     opts = params.options
     if not t_end_s >= LONG_STEP_DT_S:
@@ -50,14 +62,18 @@ def long_step_refusal(params, controller, t_end_s: float) -> str | None:
         return f"controller {controller.label}: validated for the paper's PWM-PID only"
     if params.pwm_period_s > LONG_STEP_DT_S:
         return f"pwm_period_s = {params.pwm_period_s:g} is longer than the long step ({LONG_STEP_DT_S:g} s)"
+    if program is not None and len(program.steps) > 1:
+        gap = float(np.min(np.diff(program.arrays()[0])))
+        if gap < PROGRAM_MIN_STEP_S:
+            return f"the drive program has steps {gap:g} s apart (the long step needs {PROGRAM_MIN_STEP_S:g} s or more)"
     return None
 
 
 def choose(params, controller, t_end_s: float, method: str | None, dt_s: float | None,
-           pwm: str | None) -> Numerics:
+           pwm: str | None, program=None) -> Numerics:
     """The run's numerics: the given values, else the run's default (module docstring)."""
     if method is None and dt_s is None and pwm is None:
-        return LONG_STEP if long_step_refusal(params, controller, t_end_s) is None else REFERENCE
+        return LONG_STEP if long_step_refusal(params, controller, t_end_s, program) is None else REFERENCE
     return Numerics(REFERENCE.method if method is None else method,
                     REFERENCE.dt_s if dt_s is None else dt_s,
                     REFERENCE.pwm if pwm is None else pwm)

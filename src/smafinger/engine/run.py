@@ -97,7 +97,7 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
         controller = controller_from(controller).prepared(p)
         if strategy == "open-loop":
             raise ProfileError(f"a controller ({controller.label}) is only used in closed loop, not with open-loop")
-    dt_s, method, pwm = _numerics(p, controller, t_end_s, method, dt_s, pwm)
+    dt_s, method, pwm = _numerics(p, controller, t_end_s, method, dt_s, pwm, voltage)
     pwm_model = pwm_models.get(pwm)
     if integrators.get(method).pwm_sampled and pwm_model != pwm_models.PwmModel.EXACT:
         raise ValueError(f"pwm = {pwm!r} does not apply to method = {method!r}, which reads the PWM at its stages")
@@ -122,9 +122,9 @@ _ARG_TYPES = {
 }
 
 
-def _numerics(p, controller, t_end_s, method, dt_s, pwm) -> tuple:
+def _numerics(p, controller, t_end_s, method, dt_s, pwm, program) -> tuple:
     """(dt_s, method, pwm): those given, else the run's default (:mod:`.numerics`)."""
-    n = numerics.choose(p, controller, t_end_s, method, dt_s, pwm)
+    n = numerics.choose(p, controller, t_end_s, method, dt_s, pwm, program)
     return n.dt_s, n.method, n.pwm
 
 
