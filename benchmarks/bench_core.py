@@ -1,10 +1,11 @@
 """Speed and accuracy of the engine on the co-operative full cycle (issue 2's goal).
 
 Prints the warm wall time of the co-operative full cycle -40 -> -25 -> -55 -> -40 (45 s
-simulated) at default settings, and its error (RMS and max, deg) against a 1 us reference
-run; the goal is <= 50 ms on one core with <= 0.05 deg RMS. Run:
-``python benchmarks/bench_core.py``. Also prints both integrators at 2, 1 and 0.5 ms
-(best of 3), to show why the default is what it is.
+simulated) at the reference numerics (rk4, 1 ms, exact PWM: the default before the
+long-step default of docs/speed.md, whose figures benchmarks/bench_speed.py prints), and its
+error (RMS and max, deg) against a 1 us reference run; the goal is <= 50 ms on one core with
+<= 0.05 deg RMS. Run: ``python benchmarks/bench_core.py``. Also prints both integrators at 2,
+1 and 0.5 ms (best of 3), to show why the reference is what it is.
 """
 
 from __future__ import annotations
@@ -33,7 +34,7 @@ def main() -> None:
     t0 = time.perf_counter()
     ref = run_spec(spec(1e-6))
     t_ref = time.perf_counter() - t0
-    print(f"co-operative full cycle, 45 s simulated, paper2010, default {DEFAULT_METHOD}, dt = {1e3 * DEFAULT_DT_S:g} ms")
+    print(f"co-operative full cycle, 45 s simulated, paper2010, reference {DEFAULT_METHOD}, dt = {1e3 * DEFAULT_DT_S:g} ms")
     print(f"  wall (kernel only, warm): median {1e3 * statistics.median(walls):.1f} ms, min {1e3 * min(walls):.1f} ms "
           f"({r.substeps} sub-steps)   goal <= 50 ms")
     err = r.theta_deg - ref.theta_deg

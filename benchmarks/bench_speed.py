@@ -156,7 +156,8 @@ def bench_legacy(paper: dict, legacy_src: Path | None, repeat: int) -> None:
               f"{LEGACY['rms_deg']} deg RMS ({LEGACY['substeps']} sub-steps)")
         print(f"   RATIO legacy/long {lo / (fast['best_s'] * 1e3):.1f}-{hi / (fast['best_s'] * 1e3):.1f}x, "
               f"legacy/reference {lo / (today['best_s'] * 1e3):.2f}-{hi / (today['best_s'] * 1e3):.2f}x "
-              "(recorded numbers, not measured in this run: --legacy-src measures them)")
+              "(recorded CPU times of the whole run_spec against this run's kernel-only times: not measured "
+              "side by side; --legacy-src measures them)")
         return
     rows = {"legacy (ff21ad0) default: rk4 1 ms": (legacy_src,),
             "this engine, default (long step)": (SRC,),

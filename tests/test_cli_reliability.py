@@ -18,7 +18,6 @@ from scipy.io import loadmat
 from smafinger import export
 from smafinger.cli import app, main
 from smafinger.engine.integrators import INTEGRATORS
-from smafinger.engine.run import make_spec
 from smafinger.engine.signals import MECHANISM_FIELDS, WIRE_FIELDS
 
 QUICK = ["--profile", "0:-25", "--t-end", "1", "--no-progress"]
@@ -218,11 +217,11 @@ def test_sweep_writes_a_matlab_table_with_provenance(tmp_path, capsys):
     assert list(m["sweep"]["h0_heating_W_m2K"][()]) == [60.0, 70.0]
     assert list(m["sweep"]["run_id"][()]) == table["run_id"].tolist()
     prov = json.loads(str(m["provenance"]["provenance_json"][()]))
-    base = make_spec("paper2010-table2", "open-loop", voltage="0:8:0,2:0:0", t_end_s=3.0)
     assert prov["base_parameters"]["name"] == "paper2010-table2"
-    # the numerics as the runs resolve them, not make_spec's None
+    # the numerics as the runs resolve them (the long step: open loop, program steps 2 s apart)
     assert {k: prov["base_run_settings"][k] for k in ("dt_s", "method", "pwm")} == \
-        {"dt_s": base.dt_s, "method": base.method, "pwm": base.pwm}
+        {"dt_s": 0.005, "method": "exponential", "pwm": "averaged"}
+    assert set(table["run_method"]) == {"exponential"} and set(table["run_pwm"]) == {"averaged"}
     meta = json.loads(pq.read_schema(tmp_path / "s.parquet").metadata[b"smafinger.sweep"])
     assert meta["provenance"] == prov
 

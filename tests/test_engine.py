@@ -82,8 +82,9 @@ def test_blow_up_reports_time_and_state():
         simulate(p, "open-loop", voltage="0:8:0", t_end_s=5.0, dt_s=1e-3)
 
 
-def test_interlock_counter_counts_a_forced_violation():
-    spec = make_spec("paper2010", "open-loop", voltage="0:8:0", t_end_s=0.1)
+@pytest.mark.parametrize("numerics", [{}, {"method": "rk4"}])  # the long-step default, the reference
+def test_interlock_counter_counts_a_forced_violation(numerics):
+    spec = make_spec("paper2010", "open-loop", voltage="0:8:0", t_end_s=0.1, **numerics)
     args = kernel_args(spec)
     prog = args["prog"]
     forced = prog._replace(level=np.array([[8.0, 8.0]]), duty=np.array([[100.0, 100.0]]))  # bypasses the check

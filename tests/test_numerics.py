@@ -71,12 +71,19 @@ def test_the_default_full_cycle_is_within_the_accuracy_budget():
     np.testing.assert_allclose(fast.segment_reached_s, ref.segment_reached_s, atol=0.01)
 
 
+def test_whole_wire_heating_keeps_the_reference():
+    """Not validated at long steps: paper2010-table2 with whole-wire heating, full cycle, 1.2 deg RMS."""
+    p = get("paper2010-table2").replace(joule_heating="whole-wire")
+    assert _numerics(make_spec(p, *CYCLE[1:], t_end_s=45.0)) == REF
+
+
 def test_the_command_line_reports_the_numerics_it_used(tmp_path):
-    cases = (([], LONG), (["--dt", "0.001"], REF), (["--method", "exponential"], ("exponential", 1e-3, "exact")))
+    cases = (([], LONG), (["--dt", "0.001"], REF), (["--method", "exponential"], ("exponential", 1e-3, "exact")),
+             (["--scenario", "fig15-cooperative-v1"], REF))
     for i, (extra, want) in enumerate(cases):
         out = tmp_path / f"s{i}.json"
-        rc = main(["simulate", "--profile", "0:-25", "--t-end", "1", "--summary", str(out), "--no-progress",
-                   *extra])
+        run = ["--profile", "0:-25"] if "--scenario" not in extra else []
+        rc = main(["simulate", *run, "--t-end", "1", "--summary", str(out), "--no-progress", *extra])
         assert rc == 0
         run = json.loads(out.read_text())["provenance"]["run"]
         assert (run["method"], run["dt_s"], run["pwm"]) == want

@@ -92,6 +92,25 @@ def test_the_pwm_model_is_a_run_setting_with_its_own_run_id():
                     "vary": {"tol_deg": {"values": [0.5]}}}).runs()
 
 
+def test_each_row_records_the_numerics_its_run_used(tmp_path):
+    """A point's varied values can change its default numerics (engine.numerics): the rows say
+    which each run used, and an explicit dt_s gives rk4 with exact PWM (the reference's others)."""
+    spec = parse_spec({"base": {"profile": "0:-30", "t_end_s": 0.5},
+                       "vary": {"pwm_period_s": {"values": [0.001, 0.01]}, "dt_s": {"values": [0.001, 0.002]}},
+                       "sweep": {"mode": "list"}})
+    run_sweep(spec, tmp_path / "n.parquet", workers=1)
+    df = pd.read_parquet(tmp_path / "n.parquet").sort_values("point")
+    assert df["run_method"].tolist() == ["rk4", "rk4"] and df["run_pwm"].tolist() == ["exact", "exact"]
+    assert df["run_dt_s"].tolist() == [0.001, 0.002]
+    spec = parse_spec({"base": {"profile": "0:-30", "t_end_s": 0.5},
+                       "vary": {"pwm_period_s": {"values": [0.001, 0.01]}}})
+    run_sweep(spec, tmp_path / "p.parquet", workers=1)
+    df = pd.read_parquet(tmp_path / "p.parquet").sort_values("point")
+    # a 10 ms PWM period is longer than the long step: that point keeps the reference
+    assert list(zip(df["run_method"], df["run_dt_s"], df["run_pwm"])) == [("exponential", 0.005, "averaged"),
+                                                                         ("rk4", 0.001, "exact")]
+
+
 def test_random_and_lhs_sampling_seeded():
     def spec(mode, seed, n=20):
         return parse_spec({"base": {"strategy": "cooperative", "profile": "0:-30", "t_end_s": 1.0},

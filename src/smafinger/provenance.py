@@ -94,6 +94,9 @@ def spec_from_definition(definition: Any, where: str = "run definition"):
     try:
         p = from_dict({"mechanism": definition["mechanism"], **params})
         run = {k: definition[k] for k in RUN_KEYS if k != "drive"}
+        for k in ("dt_s", "method", "pwm"):  # null would mean "the default", which may change
+            if run[k] is None:
+                raise ProvenanceError(f"{where}: {k} = null: a run definition names its numerics")
         return make_spec(p, voltage=None if drive is None else drive["program"],
                          drive="voltage" if drive is None else drive["kind"],
                          controller=_controller(definition.get("controller")), **run)

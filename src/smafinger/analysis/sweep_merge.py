@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, TRACE_COLUMNS
+from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, STRING_COLUMNS, TRACE_COLUMNS
 from ..files import atomic_write
 from .sweep_store import META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids, read_meta, traces_path
 
@@ -176,7 +176,7 @@ class Finished:
 def _metric_type(name: str):
     import pyarrow as pa
 
-    if name in ("run_id", "status", "error"):
+    if name in STRING_COLUMNS:
         return pa.string()
     if name == "point" or name in INT_COLUMNS:
         return pa.int64()

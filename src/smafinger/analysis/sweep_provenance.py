@@ -22,7 +22,8 @@ from .sweep_spec import RUN_ID_SCHEMA
 
 def run_settings(run_kw: dict, params) -> dict:
     """The base run settings with make_spec's defaults filled in (the numerics as they resolve
-    for ``params``, :mod:`smafinger.engine.numerics`), as JSON values."""
+    for the base run, :mod:`smafinger.engine.numerics`; a point's varied values can change its
+    own, which its row's ``run_method``, ``run_dt_s``, ``run_pwm`` hold), as JSON values."""
     from ..engine.numerics import choose
     from ..engine.run import make_spec
     from ..profiles import TargetProfile, VoltageProgram

@@ -56,8 +56,12 @@ METRIC_COLUMNS = (
     "interlock_violations",
     *(c.format(q=q, unit=u) for q, u in COORDINATES for c in COORDINATE_METRICS),
     "motion_start_s", "steps", "wall_s",
+    # the numerics the run used (engine.numerics: a point's varied values can change its default)
+    "run_method", "run_dt_s", "run_pwm",
 )
 INT_COLUMNS = ("interlock_violations", "steps")
+#: text columns (the others are numbers)
+STRING_COLUMNS = ("run_id", "status", "error", "run_method", "run_pwm")
 #: per-segment columns: target, start, reach time and overshoot (target and overshoot in every unit)
 SEGMENT_COLUMNS = (f"target_{UNITS[0]}", "start_s", "reached_s", f"overshoot_{UNITS[0]}",
                    *(f"{c}_{u}" for u in UNITS[1:] for c in ("target", "overshoot")))
@@ -84,6 +88,7 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         f"{q}_max_{unit}": float(np.max(x)), f"{q}_min_{unit}": float(np.min(x)), f"{q}_final_{unit}": float(x[-1]),
         "motion_start_s": float(t[moved[0]]) if moved.size else math.nan,
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
+        "run_method": result.spec.method, "run_dt_s": float(result.spec.dt_s), "run_pwm": result.spec.pwm,
     })
     segs = {seg["index"]: seg for seg in s["segments"]}
     for i, seg_def in enumerate(result.spec.profile.segments):

@@ -9,13 +9,15 @@ import typer
 
 from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, LONG_STEP_DT_S,
                       LONG_STEP_METHOD, LONG_STEP_PWM)
-
-#: the numerics options' shared note on their default (engine.numerics)
-NUMERICS_HELP = (f"[default: none of --dt/--method/--pwm given: {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
-                 f"{LONG_STEP_PWM} for the finger joint with the memory rule and the set's PID; else, and for "
-                 f"any not given: {DEFAULT_METHOD}, {DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
 from .common import Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
+
+#: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
+NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
+                 f"{LONG_STEP_PWM} where validated (the finger joint, its rate law, the memory rule, per-metre "
+                 f"heating and the paper's PID; in open loop a program with steps 0.5 s apart or more); "
+                 f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
+                 f"{DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
 
 #: options that define the run (refused with --from; --scenario takes some of them)
 RUN_OPTIONS = ("params", "set_", "scenario", "strategy", "profile", "voltage", "duty", "current", "t_end", "dt",
@@ -46,11 +48,11 @@ def simulate(
                                        help="open-loop program: duty 0-1 of the supply V_H"),
     current: Optional[str] = typer.Option(None, "--current", metavar="T:I_1[:I_2],...", help="open-loop program [A]"),
     t_end: float = typer.Option(20.0, "--t-end", metavar="S", help="simulated time [s]"),
-    dt: Optional[float] = typer.Option(None, "--dt", metavar="S", help=f"integration step [s] {NUMERICS_HELP}"),
+    dt: Optional[float] = typer.Option(None, "--dt", metavar="S", help="integration step [s] [default: see --method]"),
     method: Optional[Method] = typer.Option(None, "--method", help="integrator (authors-ode4: the authors' Simulink "
                                                                    f"solver, fixed 1 ms, PWM read at its stages) {NUMERICS_HELP}"),
     pwm: Optional[Pwm] = typer.Option(None, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
-                                                          f"averaged power (averaged: long steps) {NUMERICS_HELP}"),
+                                                          "averaged power (averaged: long steps) [default: see --method]"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
     tol_deg: float = typer.Option(0.5, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
     tol_m: float = typer.Option(DEFAULT_TOL_M, "--tol-m", metavar="M", help="target tolerance of a linear actuator [m]"),

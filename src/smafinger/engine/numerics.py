@@ -2,8 +2,8 @@
 
 A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets the long-step settings
 (exponential Euler, 5 ms, period-averaged PWM) where they were validated against a 1 us run
-with exact PWM edges (closed loop, and open loop under a program switched at most every 0.5 s),
-and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
+with exact PWM edges (closed loop, and open loop under a program whose steps are at least
+0.5 s apart), and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
 run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where the long step holds and why it does not elsewhere:
 docs/speed.md.
@@ -15,15 +15,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..parameters.options import Hysteresis, StressLaw
+from ..parameters.options import Hysteresis, JouleHeating, StressLaw
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
                        LONG_STEP_PWM)
 
 #: an open-loop drive program with two steps closer than this keeps the reference [s]: the long
 #: step's first-order wire update drifts with every switch. An 80 % square wave at 8 V for 8 s
 #: against rk4 at 0.1 ms: steps 1.6/0.4 s apart 0.021 deg RMS, 0.4/0.1 s 0.031, 0.08/0.02 s 0.12,
-#: 8/2 ms 3.5 (rk4 at 1 ms: 0.001-0.008). Set above the largest gap measured to drift, as the
-#: drift grows with the number of switches (docs/speed.md).
+#: 8/2 ms 3.5 (rk4 at 1 ms: 0.001-0.008). Conservative: 0.1 s gaps stayed within the budget over
+#: those 16 periods, but the drift adds up with every switch (docs/speed.md).
 PROGRAM_MIN_STEP_S = 0.5
 
 
@@ -43,8 +43,10 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
 
     Validated (benchmarks/bench_speed.py; every paper2010 scenario within 0.08 deg RMS of a
     0.1 ms RK4 run, the full cycle 0.013 deg): the finger joint, the rate-form stress law, the
-    return-point-memory hysteresis and the paper's PWM-PID (``controller`` None or ``pid``, a
-    prepared :class:`~smafinger.control.params.ControllerParameters`), with a PWM period no
+    return-point-memory hysteresis, per-metre Joule heating (the paper's sets; ``whole-wire``
+    heating of ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step) and the
+    paper's PWM-PID (``controller`` None or ``pid``, a prepared
+    :class:`~smafinger.control.params.ControllerParameters`; its gains are not checked), with a PWM period no
     longer than the step (the average then covers whole periods), and an open-loop ``program``
     (:class:`~smafinger.profiles.VoltageProgram`) whose steps are :data:`PROGRAM_MIN_STEP_S`
     apart or more.
@@ -56,6 +58,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
         return f"mechanism {params.mechanism}: the wire pulls the load directly, a mode only short steps resolve"
     if opts.stress_law != StressLaw.RATE:
         return "the algebraic stress law has not been validated at long steps"
+    if opts.joule_heating != JouleHeating.PER_METRE:
+        return f"joule_heating {opts.joule_heating.label}: not validated at long steps (1.2 deg RMS on the full cycle)"
     if opts.hysteresis != Hysteresis.MEMORY:
         return f"hysteresis {opts.hysteresis.label}: its branch follows the PWM ripple the average removes"
     if controller is not None and controller.label != "pid":
