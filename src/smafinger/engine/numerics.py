@@ -42,14 +42,16 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
     """Why the long-step settings are not this run's default (None: they are).
 
     Validated (benchmarks/bench_speed.py; every paper2010 scenario within 0.08 deg RMS of a
-    0.1 ms RK4 run, the full cycle 0.013 deg): the finger joint, the rate-form stress law, the
-    return-point-memory hysteresis, per-metre Joule heating (the paper's sets; ``whole-wire``
-    heating of ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step) and the
-    paper's PWM-PID (``controller`` None or ``pid``, a prepared
-    :class:`~smafinger.control.params.ControllerParameters`; its gains are not checked), with a PWM period no
-    longer than the step (the average then covers whole periods), and an open-loop ``program``
-    (:class:`~smafinger.profiles.VoltageProgram`) whose steps are :data:`PROGRAM_MIN_STEP_S`
-    apart or more.
+    0.1 ms RK4 run, the full cycle 0.013 deg) for:
+
+    - the finger joint, the rate-form stress law, the return-point-memory hysteresis;
+    - per-metre Joule heating (the paper's sets; ``whole-wire`` heating of
+      ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step);
+    - the paper's PWM-PID: ``controller`` None or ``pid`` (a prepared
+      :class:`~smafinger.control.params.ControllerParameters`); its gains are not checked;
+    - a PWM period no longer than the step (the average then covers whole periods);
+    - in open loop, a ``program`` (:class:`~smafinger.profiles.VoltageProgram`) whose steps
+      are :data:`PROGRAM_MIN_STEP_S` apart or more.
     """
     opts = params.options
     if not t_end_s >= LONG_STEP_DT_S:
