@@ -32,6 +32,7 @@ class SimulationResult:
     substeps: int
     interlock_violations: int
     wall_s: float
+    engine: str = "compiled"  #: the kernel that ran: compiled, or interpreted (engine.interpreted)
     _metrics: dict | None = field(default=None, repr=False)
 
     # ---- signals ---------------------------------------------------------------------
@@ -115,6 +116,7 @@ class SimulationResult:
         m["t_end_s"] = self.spec.t_end_s
         m["steps"] = self.substeps
         m["wall_s"] = self.wall_s
+        m["engine"] = self.engine
         return m
 
     def write_summary(self, path: str | Path) -> None:

@@ -9,7 +9,7 @@ from typing import Literal
 import typer
 
 from ..progress import Display
-from .choices import METHOD_NAMES, PWM_NAMES, STRATEGY_NAMES
+from .choices import ENGINES, METHOD_NAMES, PWM_NAMES, STRATEGY_NAMES
 from .errors import UsageError, reading_input
 
 #: ``--strategy`` values (``--help`` lists them)
@@ -17,6 +17,8 @@ Strategy = Literal[STRATEGY_NAMES]
 #: ``--method`` values
 Method = Literal[METHOD_NAMES]
 Pwm = Literal[PWM_NAMES]
+#: ``--engine`` values (engine.interpreted)
+Engine = Literal[ENGINES]
 
 
 def given(ctx: typer.Context, *names: str) -> list[str]:

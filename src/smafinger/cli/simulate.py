@@ -2,14 +2,15 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import List, Optional
 
 import typer
 
-from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, LONG_STEP_DT_S,
-                      LONG_STEP_METHOD, LONG_STEP_PWM)
-from .common import Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
+from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINE_ENV,
+                      LONG_STEP_DT_S, LONG_STEP_METHOD, LONG_STEP_PWM)
+from .common import Engine, Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
 #: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
@@ -62,19 +63,28 @@ def simulate(
     summary: Optional[Path] = typer.Option(None, "--summary", metavar="FILE.json", help="metrics and provenance"),
     plot: Optional[Path] = typer.Option(None, "--plot", metavar="FILE", help="figure to FILE.png, .pdf or .svg"),
     progress: Optional[bool] = progress_option(),
+    engine: Optional[Engine] = typer.Option(
+        None, "--engine", help="compiled: the numba kernel (compiled first if not cached); interpreted: the same "
+                               "kernel as plain Python; auto: compiled if cached, else a short run interpreted while "
+                               f"the kernel compiles in the background [default: ${ENGINE_ENV}, else auto]"),
 ):
     """Simulate an SMA actuator (the finger joint or a linear bias-spring rig) and report the metrics."""
+    from ..engine.interpreted import engine_setting
     from ..engine.run import SimulationError, run_spec
     from ..export import add_plot, add_signals, add_summary
     from ..files import Outputs
     from ..plausibility import blowup_hint
 
     _check_outputs(out, summary, plot)
+    try:
+        setting = engine_setting(engine)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     spec, extra = _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt,
                         method, pwm, output_interval, tol_deg, tol_m, hold_s)
     with progress_display(progress) as display:
         try:
-            result = run_spec(spec, progress=display)
+            result = run_spec(spec, progress=display, engine=setting)
         except SimulationError as exc:
             raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
     outputs = Outputs()
@@ -88,6 +98,11 @@ def simulate(
     from .show import print_run
 
     print_run(result)
+    if result.engine == "interpreted":
+        print(f"smafinger: note: this run was interpreted ({result.wall_s:.1f} s; the same equations as the compiled "
+              "kernel, equal to rounding)" + ("" if setting != "auto" else
+                                             ": the compiled kernel was not in numba's cache, and is being compiled "
+                                             "in the background for the runs that follow"), file=sys.stderr)
 
 
 def _check_outputs(out: Path | None, summary: Path | None, plot: Path | None) -> None:

@@ -42,23 +42,29 @@ KINDS: tuple[Kind, ...] = (
 )
 
 
+_KIND_BY_RECORD = {k.record: k for k in KINDS}
+
+
 def _kind(ctrl) -> Kind | None:
+    """The kind of a controller record's numba type (compiled dispatch)."""
     if not isinstance(ctrl, types.BaseNamedTuple):
         return None
-    for k in KINDS:
-        if ctrl.instance_class is k.record:
-            return k
-    return None
+    return _KIND_BY_RECORD.get(ctrl.instance_class)
+
+
+def _kind_of(ctrl) -> Kind:
+    """The kind of a controller record (interpreted dispatch: numba's JIT disabled)."""
+    return _KIND_BY_RECORD[type(ctrl)]
 
 
 def control_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
-    """(commands, integrating, cstate) at a control tick; compiled code only (see the module docstring)."""
-    raise NotImplementedError("control_tick() is compiled code: call it from a numba function")
+    """(commands, integrating, cstate) at a control tick (see the module docstring)."""
+    return _kind_of(ctrl).tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started)
 
 
 def initial_control_state(ctrl, model):
-    """The controller's own state at t = 0; compiled code only."""
-    raise NotImplementedError("initial_control_state() is compiled code: call it from a numba function")
+    """The controller's own state at t = 0."""
+    return _kind_of(ctrl).initial(ctrl, model)
 
 
 @overload(control_tick)

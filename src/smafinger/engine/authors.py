@@ -86,23 +86,36 @@ def derivative_block(error, error_last, dt):
 def pid_at_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
     """(commands, integrating): the paper's PID (Eq. 12a) at state ``y`` with the error rate
     ``error_rate`` (their Derivative block's) in place of -q'; any other controller keeps
-    ``cmds`` (the authors' solver emulates their PID only). Compiled code only: dispatched on
-    the controller record's type."""
-    raise NotImplementedError("pid_at_rate() is compiled code: call it from a numba function")
+    ``cmds`` (the authors' solver emulates their PID only). Dispatched on the controller
+    record's type (:data:`_RATE_LAWS`)."""
+    impl = _RATE_LAWS.get(type(ctrl), _keep_commands)
+    return impl(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate)
+
+
+@njit(cache=True, forceinline=True)
+def _pid_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
+    e = q_target - y.q
+    u = pid_output(e, error_rate, y.error_integral, ctrl.K_P, ctrl.K_V, ctrl.K_I)
+    return (phase_commands(model, enabled, u, q_target, y.q, model.drive.V_H_V),
+            integrating_flag(model, u, e))
+
+
+@njit(cache=True, forceinline=True)
+def _keep_commands(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
+    return cmds, integrating
+
+
+#: the controller records the authors' solver emulates, and their law at a given error rate
+_RATE_LAWS = {Controller: _pid_rate}
 
 
 @overload(pid_at_rate)
 def _pid_at_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
-    if isinstance(ctrl, types.BaseNamedTuple) and ctrl.instance_class is Controller:
-        def impl(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
-            e = q_target - y.q
-            u = pid_output(e, error_rate, y.error_integral, ctrl.K_P, ctrl.K_V, ctrl.K_I)
-            return (phase_commands(model, enabled, u, q_target, y.q, model.drive.V_H_V),
-                    integrating_flag(model, u, e))
-    else:
-        def impl(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
-            return cmds, integrating
-    return impl
+    if not isinstance(ctrl, types.BaseNamedTuple):
+        return None
+    law = _RATE_LAWS.get(ctrl.instance_class, _keep_commands)
+    return lambda ctrl, model, enabled, q_target, y, cmds, integrating, error_rate: law(
+        ctrl, model, enabled, q_target, y, cmds, integrating, error_rate)
 
 
 @njit(cache=True, forceinline=True)

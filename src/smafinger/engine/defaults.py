@@ -23,6 +23,10 @@ LONG_STEP_DT_S = 5e-3
 LONG_STEP_METHOD = "exponential"
 LONG_STEP_PWM = "averaged"
 
+#: the engines a single run may use (engine.interpreted); the default comes from ENGINE_ENV, else "auto"
+ENGINES = ("auto", "compiled", "interpreted")
+ENGINE_ENV = "SMAFINGER_ENGINE"
+
 #: default target tolerance of the linear actuator [m]
 DEFAULT_TOL_M = 5e-4
 

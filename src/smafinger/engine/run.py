@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import PurePath
 
 import numpy as np
-from numba import typeof
+from numba import config as numba_config, typeof
 
 from ..control.params import ControllerParameters, controller_from
 from ..control.strategies import STRATEGIES, enable_mask
@@ -19,13 +19,17 @@ from ..parameters import ParameterSet, resolve
 from ..progress import Display
 from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
-from . import integrators, numerics, pwm as pwm_models
+from . import integrators, interpreted, numerics, pwm as pwm_models
 from .kernel import Program, RunSettings, run_kernel
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M  # noqa: F401
 from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
 
+
+
+#: numba's JIT is disabled in this process: the kernel runs as Python (:mod:`.interpreted`)
+INTERPRETED = bool(numba_config.DISABLE_JIT)
 
 
 class SimulationError(RuntimeError):
@@ -244,7 +248,8 @@ class _CompiledKernels:
     numba types every argument at every call, and typing the nested records costs about a
     millisecond; their types depend only on the mechanism and the controller's record type
     (every value is a float, every option an enum member), so the entry point is looked up once
-    per mechanism, wire count and controller.
+    per mechanism, wire count and controller (:func:`kernel_key`). With numba's JIT disabled
+    (the interpreted engine, :mod:`.interpreted`) the kernel is its Python function.
     """
 
     def __init__(self) -> None:
@@ -252,11 +257,30 @@ class _CompiledKernels:
 
     def __call__(self, key: tuple, args: tuple):
         fn = self._entry.get(key)
+        if fn is None and INTERPRETED:
+            fn = self._entry[key] = run_kernel
         if fn is None:
             sig = tuple(typeof(a) for a in args)
             run_kernel.compile(sig)
             fn = self._entry[key] = run_kernel.overloads[sig].entry_point
         return fn
+
+    def cached(self, key: tuple, args: tuple) -> bool:
+        """Is the kernel for these arguments loaded, or in numba's cache (so no compile is needed)?
+
+        Reads the cache's index as numba's ``Dispatcher.compile`` does before compiling; if
+        that fails (another numba version), says yes: the caller then compiles as before.
+        """
+        if key in self._entry or INTERPRETED:
+            return True
+        try:
+            sig = tuple(typeof(a) for a in args)
+            cache = run_kernel._cache
+            run_kernel.targetctx.refresh()
+            index = cache._cache_file._load_index()
+            return cache._index_key(sig, run_kernel.targetctx.codegen()) in index
+        except Exception:  # noqa: BLE001 - a numba internal changed: compile as before
+            return True
 
 
 _kernels = _CompiledKernels()
@@ -267,22 +291,44 @@ def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tupl
     return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
 
 
-def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
-    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
-
-    ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
-    :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
-    a thread, so that Ctrl-C is answered at once).
-    """
+def _prepared(spec: RunSpec) -> tuple:
+    """(kernel arguments, kernel key, mechanism and wire outputs, segment starts and reaches)."""
     args = kernel_args(spec)
     run = args["run"]
-    n_wires = len(spec.params.wire_names)
-    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, n_wires)
+    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, len(spec.params.wire_names))
     n_seg = len(spec.profile.segments)
     seg_actual = np.full(n_seg, -1, dtype=np.int64)
     seg_reached = np.full(n_seg, -1, dtype=np.int64)
     call_args = _kernel_args_tuple(args, mech, wires, seg_actual, seg_reached)
-    key = (spec.params.mechanism, n_wires, type(args["model"].controller))
+    key = (spec.params.mechanism, len(spec.params.wire_names), type(args["model"].controller))
+    return call_args, key, mech, wires, seg_actual, seg_reached
+
+
+def kernel_key(spec: RunSpec) -> tuple:
+    """What the compiled kernel depends on: the mechanism, the wire count, the controller's record type."""
+    return _prepared(spec)[1]
+
+
+def compile_kernel(spec: RunSpec) -> None:
+    """Compile the kernel ``spec`` needs (or load it from numba's cache), without running it."""
+    call_args, key = _prepared(spec)[:2]
+    _kernels(key, call_args)
+
+
+def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResult:
+    """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
+
+    ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
+    :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
+    a thread, so that Ctrl-C is answered at once). ``engine``: ``compiled``, ``interpreted`` or
+    ``auto`` (:mod:`.interpreted`; an interpreted run shows no progress).
+    """
+    call_args, key, mech, wires, seg_actual, seg_reached = _prepared(spec)
+    if engine != "compiled" and not INTERPRETED:
+        if interpreted.choose(engine, _kernels.cached(key, call_args), spec) == "interpreted":
+            if engine == "auto":
+                interpreted.build_in_background(spec)
+            return interpreted.run_interpreted(spec)
     kernel = _kernels(key, call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress is True or isinstance(progress, Display):
@@ -295,7 +341,8 @@ def run_spec(spec: RunSpec, progress=False) -> SimulationResult:
     return SimulationResult(
         spec=spec, mechanism=mech, wires=wires, segment_start_s=seg_actual * TICK_S,
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
-        substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall)
+        substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall,
+        engine="interpreted" if INTERPRETED else "compiled")
 
 
 def describe_state(p: ParameterSet, state) -> str:
@@ -338,7 +385,7 @@ def _run_with_progress(call, mech, t_end_s, progress):
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
              dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
              hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
-             pwm=None, controller=None):
+             pwm=None, controller=None, engine=None):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
@@ -378,6 +425,11 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     controller : str or ControllerParameters, optional
         The closed-loop controller (:mod:`smafinger.control.params`: ``pid``, ``fuzzy-pid``,
         ``sliding-mode``, ``rapid-heating``, ``resistance``); default the paper's PWM-PID.
+    engine : {"auto", "compiled", "interpreted"}, optional
+        Default ``$SMAFINGER_ENGINE``, else ``auto``: the compiled kernel if numba has it cached;
+        if not, a short run interpreted (plain Python in a child process, the same equations;
+        about 1 s for the paper's 45 s cycle at the long step) while the kernel compiles in the
+        background for later runs (:mod:`.interpreted`).
 
     Returns
     -------
@@ -385,4 +437,4 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
                      tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
-    return run_spec(spec, progress=progress)
+    return run_spec(spec, progress=progress, engine=interpreted.engine_setting(engine))

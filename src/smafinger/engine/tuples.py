@@ -7,6 +7,9 @@ length; ``out = set_item(out, i, f(wires[i]))`` replaces an item (a new tuple, b
 ``set_item`` is generated for the tuple's length as a chain of ``if i == k`` rebuilding the
 tuple: numba's own ``tuple_setitem`` stores through a stack slot at a run-time index, which LLVM
 cannot keep in registers, and that slowed the engine two-fold.
+
+Each helper's Python body does the same in plain Python, for the interpreted engine
+(:mod:`.interpreted`, numba's JIT disabled).
 """
 
 from numba import types
@@ -14,8 +17,8 @@ from numba.extending import overload
 
 
 def set_item(tup, i, value):
-    """A copy of the homogeneous tuple ``tup`` with item ``i`` replaced (compiled code only)."""
-    raise NotImplementedError("set_item() is compiled code: call it from a numba function")
+    """A copy of the homogeneous tuple ``tup`` with item ``i`` replaced."""
+    return tup[:i] + (value,) + tup[i + 1:]
 
 
 @overload(set_item)
@@ -34,8 +37,8 @@ def _set_item(tup, i, value):
 
 
 def filled(template, value):
-    """A tuple as long as ``template`` with every item ``value`` (compiled code only)."""
-    raise NotImplementedError("filled() is compiled code: call it from a numba function")
+    """A tuple as long as ``template`` with every item ``value``."""
+    return (value,) * len(template)
 
 
 @overload(filled)
@@ -51,9 +54,9 @@ def _filled(template, value):
 def with_field(record, name, value):
     """A copy of the NamedTuple ``record`` with field ``name`` (a literal string) set to ``value``.
 
-    Compiled code only (numba has no ``_replace``); ``value`` must have the field's type.
+    numba has no ``_replace``; in compiled code ``value`` must have the field's type.
     """
-    raise NotImplementedError("with_field() is compiled code: call it from a numba function")
+    return record._replace(**{name: value})
 
 
 @overload(with_field, prefer_literal=True)

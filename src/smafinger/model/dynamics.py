@@ -50,15 +50,27 @@ def bias_force(load, x):
 
 def external_load(load, q, cos_q):
     """The mechanism's load at q, apart from the wires; dispatched on the load's type."""
-    raise NotImplementedError("external_load() is compiled code: call it from a numba function")
+    return _LOADS[type(load)](load, q, cos_q)
+
+
+def _joint_load(load, q, cos_q):
+    return gravity_moment(load, cos_q)
+
+
+def _slider_load(load, q, cos_q):
+    return bias_force(load, q)
+
+
+#: each load record and its load function, called as f(load, q, cos_q)
+_LOADS = {JointLoad: njit(cache=True, forceinline=True)(_joint_load),
+          SliderLoad: njit(cache=True, forceinline=True)(_slider_load)}
 
 
 @overload(external_load)
 def _external_load(load, q, cos_q):
-    if isinstance(load, types.BaseNamedTuple) and load.instance_class is JointLoad:
-        return lambda load, q, cos_q: gravity_moment(load, cos_q)
-    if isinstance(load, types.BaseNamedTuple) and load.instance_class is SliderLoad:
-        return lambda load, q, cos_q: bias_force(load, q)
+    if isinstance(load, types.BaseNamedTuple) and load.instance_class in _LOADS:
+        f = _LOADS[load.instance_class]
+        return lambda load, q, cos_q: f(load, q, cos_q)
     return None
 
 

@@ -103,15 +103,18 @@ def direct_pull(rt, x):
 
 def route(rt, q):
     """The :class:`WireGeometry` of a wire at coordinate q; dispatched on the route's type."""
-    raise NotImplementedError("route() is compiled code: call it from a numba function")
+    return _ROUTES[type(rt)](rt, q)
+
+
+#: each route record and its geometry function
+_ROUTES = {TendonRoute: tendon_route, DirectPull: direct_pull}
 
 
 @overload(route)
 def _route(rt, q):
-    if isinstance(rt, types.BaseNamedTuple) and rt.instance_class is TendonRoute:
-        return lambda rt, q: tendon_route(rt, q)
-    if isinstance(rt, types.BaseNamedTuple) and rt.instance_class is DirectPull:
-        return lambda rt, q: direct_pull(rt, q)
+    if isinstance(rt, types.BaseNamedTuple) and rt.instance_class in _ROUTES:
+        f = _ROUTES[rt.instance_class]
+        return lambda rt, q: f(rt, q)
     return None
 
 

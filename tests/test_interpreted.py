@@ -1,0 +1,154 @@
+"""The interpreted engine (engine.interpreted): the kernel run as plain Python (numba's JIT
+disabled) gives the compiled kernel's results to rounding; ``auto`` answers a run without a
+cached kernel interpreted and compiles the kernel in the background for the next."""
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from smafinger.engine import interpreted
+from smafinger.engine.run import _kernels, _prepared, make_spec, run_spec
+from smafinger.paper import scenarios
+from smafinger.parameters import get
+
+CYCLE = ("paper2010", "cooperative", "0:-25,reach:-55,reach:-40")
+
+#: one run per kernel variant and integrator family: the paper's full cycle at the long step,
+#: its Table II open-loop run at rk4 with the PWM resolved, the linear rig (algebraic stress
+#: law, slider), the authors' solver on authors2020, a built-in controller (ControlChain)
+CASES = {
+    "full-cycle-long-step": lambda: make_spec(*CYCLE, t_end_s=45.0),
+    "open-loop-rk4": lambda: make_spec("paper2010-table2", "open-loop", voltage="0:8:0,3:0:8", t_end_s=6.0),
+    "linear-rig": lambda: make_spec("linear-bias-spring", "cooperative", "0:0.010,4:0.004", t_end_s=8.0),
+    "authors-ode4": lambda: make_spec("authors2020", "independent", "0:-25:upper,5:-55:both", t_end_s=8.0,
+                                      method="authors-ode4"),
+    "fuzzy-pid": lambda: make_spec("paper2010", "cooperative", "0:-25,6:-55", t_end_s=10.0, controller="fuzzy-pid"),
+}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_the_interpreted_engine_gives_the_compiled_results_to_rounding(case):
+    spec = CASES[case]()
+    compiled = run_spec(spec, engine="compiled")
+    plain = run_spec(spec, engine="interpreted")
+    assert (compiled.engine, plain.engine) == ("compiled", "interpreted")
+    assert plain.substeps == compiled.substeps
+    assert plain.interlock_violations == compiled.interlock_violations
+    np.testing.assert_array_equal(plain.segment_start_s, compiled.segment_start_s)
+    np.testing.assert_array_equal(plain.segment_reached_s, compiled.segment_reached_s)
+    a, b = plain.to_pandas(), compiled.to_pandas()
+    assert list(a.columns) == list(b.columns)
+    for col in a.columns:
+        x, y = a[col].to_numpy(float), b[col].to_numpy(float)
+        scale = max(float(np.max(np.abs(y))), 1e-300)
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * scale, err_msg=col)
+
+
+def test_a_blow_up_interpreted_names_the_time_and_the_state():
+    """The child's SimulationError reaches the caller, as the compiled kernel's does."""
+    from smafinger.engine.run import SimulationError
+
+    p = get("paper2010").replace(inertia_kg_m2=1e-9)  # as tests/test_engine.py's blow-up
+    spec = make_spec(p, "open-loop", voltage="0:8:0", t_end_s=5.0, dt_s=1e-3)
+    for engine in ("compiled", "interpreted"):
+        with pytest.raises(SimulationError, match=r"blow-up at t = .* theta_rad="):
+            run_spec(spec, engine=engine)
+
+
+def test_auto_interprets_only_a_short_run_without_a_cached_kernel():
+    short = make_spec(*CYCLE, t_end_s=45.0)  # the long step: 1.3 s estimated
+    reference = make_spec(*CYCLE, t_end_s=45.0, method="rk4")  # 25 s estimated
+    long = make_spec(*CYCLE, t_end_s=300.0, method="rk4")
+    assert interpreted.interpreted_estimate_s(short) == pytest.approx(45.0 / 5e-3 * interpreted.S_PER_STAGE)
+    assert interpreted.choose("auto", False, short) == "interpreted"
+    assert interpreted.choose("auto", False, reference) == "interpreted"
+    assert interpreted.choose("auto", False, long) == "compiled"
+    assert interpreted.choose("auto", True, short) == "compiled"
+    for engine in ("compiled", "interpreted"):
+        for cached in (False, True):
+            assert interpreted.choose(engine, cached, long) == engine
+
+
+def test_the_engine_setting_comes_from_the_argument_then_the_environment(monkeypatch):
+    monkeypatch.setenv("SMAFINGER_ENGINE", "interpreted")
+    assert interpreted.engine_setting(None) == "interpreted"
+    assert interpreted.engine_setting("compiled") == "compiled"
+    monkeypatch.delenv("SMAFINGER_ENGINE")
+    assert interpreted.engine_setting(None) == "auto"
+    monkeypatch.setenv("SMAFINGER_ENGINE", "jit")
+    with pytest.raises(ValueError, match="SMAFINGER_ENGINE = 'jit' is not one of auto, compiled, interpreted"):
+        interpreted.engine_setting(None)
+    with pytest.raises(ValueError, match="engine = 'fast'"):
+        interpreted.engine_setting("fast")
+
+
+def test_a_bad_engine_in_the_environment_is_a_usage_error(tmp_path):
+    env = dict(os.environ, SMAFINGER_ENGINE="jit")
+    proc = subprocess.run([sys.executable, "-m", "smafinger.cli", "simulate", "--profile", "0:-25", "--t-end", "1",
+                           "--summary", str(tmp_path / "never.json")], env=env, capture_output=True, text=True)
+    assert proc.returncode == 2
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "SMAFINGER_ENGINE = 'jit'" in lines[0], proc.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_loaded_kernel_counts_as_cached():
+    spec = scenarios.get("fig12-extension-v1").spec()
+    run_spec(spec)
+    call_args, key = _prepared(spec)[:2]
+    assert _kernels.cached(key, call_args)
+
+
+def _index_has_kernel(cache_dir: Path) -> bool:
+    return any(cache_dir.rglob("kernel.run_kernel-*.nbi"))
+
+
+def _wait_for_build(spec, cache_dir):
+    """Until the background build of ``spec``'s kernel releases its lock (it holds it while compiling)."""
+    import fcntl
+
+    old = os.environ.get("NUMBA_CACHE_DIR")
+    os.environ["NUMBA_CACHE_DIR"] = cache_dir
+    try:
+        path = interpreted._lock_path(spec)
+    finally:
+        if old is None:
+            del os.environ["NUMBA_CACHE_DIR"]
+        else:
+            os.environ["NUMBA_CACHE_DIR"] = old
+    with open(path, "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+
+
+def test_a_fresh_install_answers_interpreted_then_compiles_in_the_background(tmp_path):
+    """An empty numba cache (a fresh install): the first ``simulate`` is interpreted and says so;
+    the kernel is compiled meanwhile by one background process; the next run loads it."""
+    env = {k: v for k, v in os.environ.items() if k != "SMAFINGER_ENGINE"}
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "cache")
+    args = [sys.executable, "-m", "smafinger.cli", "simulate", "--params", "linear-bias-spring",
+            "--profile", "0:0.010", "--t-end", "3", "--no-progress"]
+    spec = make_spec("linear-bias-spring", "cooperative", "0:0.010", t_end_s=3.0)
+    summaries = []
+    for i in range(2):
+        out = tmp_path / f"run{i}.json"
+        proc = subprocess.run([*args, "--summary", str(out)], env=env, capture_output=True, text=True, cwd=tmp_path)
+        assert proc.returncode == 0, proc.stderr
+        summaries.append(json.loads(out.read_text()))
+        if i == 0:
+            assert "this run was interpreted" in proc.stderr and "background" in proc.stderr
+            deadline = time.monotonic() + 600
+            while not _index_has_kernel(tmp_path / "cache") and time.monotonic() < deadline:
+                time.sleep(1.0)
+            assert _index_has_kernel(tmp_path / "cache"), "the background compile left no kernel in the cache"
+            _wait_for_build(spec, env["NUMBA_CACHE_DIR"])  # numba writes the index, then the kernel
+        else:
+            assert "interpreted" not in proc.stderr
+    assert [s["engine"] for s in summaries] == ["interpreted", "compiled"]
+    assert summaries[0]["segments"][0]["reached_s"] == pytest.approx(summaries[1]["segments"][0]["reached_s"],
+                                                                      abs=1e-9)
