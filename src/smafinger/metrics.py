@@ -57,6 +57,13 @@ def window(t: np.ndarray, start_s: float = -math.inf, end_s: float = math.inf) -
     return (t >= start_s - EDGE_S) & (t <= end_s + EDGE_S)
 
 
+def window_slice(t: np.ndarray, start_s: float = -math.inf, end_s: float = math.inf) -> slice:
+    """:func:`window` as a slice, for ascending ``t`` (found by bisection, without a pass over
+    the samples): ``t[window_slice(t, a, b)]`` is ``t[window(t, a, b)]``."""
+    return slice(int(np.searchsorted(t, start_s - EDGE_S, side="left")),
+                 int(np.searchsorted(t, end_s + EDGE_S, side="right")))
+
+
 def first_time(mask: np.ndarray, t: np.ndarray) -> float | None:
     """Time of the first sample where ``mask`` is true; ``None`` if there is none."""
     idx = np.flatnonzero(mask)
@@ -316,9 +323,9 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
     electrical energy is given as ``electrical_energy_J`` (and as ``energy_J``, its 0.1 name),
     its heat as ``heat_J``. ``q`` is the joint angle [deg] or a slider's position [m]; ``unit``
     names the keys (``target_deg``, ``overshoot_m``)."""
-    m = window(t, span.start_s, span.end_s)
+    m = window_slice(t, span.start_s, span.end_s)  # t: a run's output times, ascending
     # None: no output sample falls in the segment (it is shorter than the output interval)
-    some = bool(m.any())
+    some = m.stop > m.start
     electrical = {w: increase(t, e, span.start_s, span.end_s) if some else None for w, e in energy_J.items()}
     k0 = min(int(np.searchsorted(t, span.start_s - EDGE_S)), len(t) - 1)  # a segment may fall between samples
     direction = motion_direction(float(q[k0]), span.target)

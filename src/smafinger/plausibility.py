@@ -44,7 +44,10 @@ def wire_strain(sigma_Pa: np.ndarray, xi: np.ndarray, D_A_Pa: float, D_M_Pa: flo
 
 
 def _peak(values: np.ndarray, t: np.ndarray) -> tuple[float, float]:
-    i = int(np.nanargmax(values))
+    """(largest value ignoring NaN, its time); the first of equal largest values."""
+    i = int(np.argmax(values))  # the first NaN if there is one: then look again without them
+    if np.isnan(values[i]):
+        i = int(np.nanargmax(values))
     return float(values[i]), float(t[i])
 
 

@@ -11,6 +11,7 @@ the linear actuator). Columns keep their order across versions: new signals go a
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -83,6 +84,11 @@ COORDINATE_NAMES = {
 
 def columns(mechanism: str, wire_names: tuple[str, ...], q_scale: float) -> list[tuple[str, str, str | int, float]]:
     """Exported columns, in order: (name, recorded field, "mechanism" or wire index, scale)."""
+    return list(_columns(mechanism, tuple(wire_names), q_scale))
+
+
+@functools.lru_cache(maxsize=64)
+def _columns(mechanism: str, wire_names: tuple[str, ...], q_scale: float) -> tuple:
     names = COORDINATE_NAMES[mechanism]
     out = []
     for s in SIGNALS:
@@ -93,7 +99,7 @@ def columns(mechanism: str, wire_names: tuple[str, ...], q_scale: float) -> list
             out += [(s.export.format(wire=w), s.field, i, scale) for i, w in enumerate(wire_names)]
         else:
             out.append((s.export.format(**names), s.field, "mechanism", scale))
-    return out
+    return tuple(out)
 
 
 def new_outputs(n_samples: int, n_wires: int) -> tuple[np.ndarray, np.ndarray]:
