@@ -9,14 +9,15 @@ from typing import List, Optional
 import typer
 
 from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINE_ENV,
-                      LONG_STEP_DT_S, LONG_STEP_METHOD, LONG_STEP_PWM)
+                      LONG_STEP_DT_S, LONG_STEP_METHOD, LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
 from .common import Engine, Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
 #: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
-NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
-                 f"{LONG_STEP_PWM} where validated (the finger joint, its rate law, the memory rule, per-metre "
-                 f"heating and the paper's PID; in open loop a program with steps 0.5 s apart or more); "
+NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step, {LONG_STEP_DT_S:g} s, {LONG_STEP_PWM}, "
+                 f"where validated (the memory rule; in open loop a program with steps 0.5 s apart or more): "
+                 f"{LONG_STEP_METHOD} for the finger joint's rate law with per-metre heating and the paper's PID or "
+                 f"open loop, {LONG_STEP_STIFF_METHOD} for the algebraic law (the linear rig) in open loop; "
                  f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
                  f"{DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
 

@@ -9,6 +9,10 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
   for the paper's joint): about 1.1 ms (Euler) and 1.5 ms (RK4).
 - ``semi-implicit``: Euler with the damping implicit, q' = v'(new) (symplectic Euler for the
   mechanism): stable at any step against the damping; the next-stiffest mode is about 34 1/s.
+  With the algebraic stress law the wire's stiffness is implicit too (linearized by a forward
+  difference, :func:`load_stiffness`): there the stress follows q at once, and the wire's axial
+  stiffness against the inertia is a fast, barely damped mode (about 1,200 rad/s on the linear
+  rig) that made every explicit update of q unstable above about 1.7 ms.
 - ``exponential``: exponential Euler for the mechanism: (q, v) advanced exactly under the held
   load with the damping C_DF (phi functions), the wires by Euler. Like ``semi-implicit`` but
   exact for the damped motion under a constant load.
@@ -31,8 +35,9 @@ import math
 from numba import njit
 
 from ..model.records import State, WireState
+from ..parameters.options import StressLaw
 from .authors import call_branches, commit_calls, stage_inputs
-from .rhs import derivative, geometry_at
+from .rhs import derivative, geometry, geometry_at
 from .tuples import set_item, with_field
 
 
@@ -100,15 +105,35 @@ def phi2(z):
 
 
 @njit(cache=True, forceinline=True)
-def _damped_mechanism(method, y, k1, h, c):
+def load_stiffness(model, y, inputs, k1):
+    """kappa = -d(q'')/dq at the state's v and wire states [1/s^2]: the mechanism's stiffness
+    over its inertia, by a forward difference, >= 0. Only with the algebraic stress law (authors'
+    2020 model), where a wire's stress follows q at once: the wire's axial stiffness against the
+    inertia is then a fast undamped mode (about 1,200 rad/s on the linear rig). With the rate law
+    the stress is a state and q'' depends on q through the geometry alone: 0.
+    """
+    if model.options.stress_law != StressLaw.ALGEBRAIC or inputs.stuck:
+        return 0.0
+    dq = 1e-7 * (1e-3 + abs(y.q))
+    q = y.q + dq
+    k, _ = derivative(State(q, y.v, y.error_integral, y.wires), inputs, model, geometry(model, q))
+    return max(0.0, -(k.v - k1.v) / dq)
+
+
+@njit(cache=True, forceinline=True)
+def _damped_mechanism(method, y, k1, h, c, kappa):
     """(q, v) after h with the viscous damping c = C_DF / I treated implicitly or exactly.
 
     v' = a - c v with a = k1.v + c v held over the step. ``semi-implicit``: v1 = v + h k1.v /
-    (1 + c h), q1 = q + h v1. ``exponential``: v1 = v + h phi1(-c h) k1.v and q1 = q + h q' +
+    (1 + c h), q1 = q + h v1; with a stiffness kappa > 0 (a = a0 - kappa (q - q0)),
+    v1 = v + h (k1.v - kappa h v) / (1 + c h + kappa h^2). ``exponential``: v1 = v + h phi1(-c h) k1.v and q1 = q + h q' +
     h^2 phi2(-c h) k1.v (exact for a constant a). A stuck mechanism has q' = v' = 0: it stays.
     """
     if method == Method.SEMI_IMPLICIT:
-        dv = h * k1.v / (1.0 + c * h)
+        if kappa > 0.0:  # the stiffness implicit too: v1 (1 + c h + kappa h^2) = v (1 + c h) + h q''
+            dv = h * (k1.v - kappa * h * y.v) / (1.0 + c * h + kappa * h * h)
+        else:
+            dv = h * k1.v / (1.0 + c * h)
         return y.q + h * (k1.q + dv), y.v + dv
     z = -c * h
     return y.q + h * k1.q + h * h * phi2(z) * k1.v, y.v + h * phi1(z) * k1.v
@@ -130,7 +155,8 @@ def step(method, model, y, h, inputs, k1, geom, stages):
         return axpy(y, h, k1), 0, inputs
     if method == Method.SEMI_IMPLICIT or method == Method.EXPONENTIAL:
         ye = axpy(y, h, k1)
-        q, v = _damped_mechanism(method, y, k1, h, inputs.viscous / model.dynamics.inertia)
+        kappa = load_stiffness(model, y, inputs, k1) if method == Method.SEMI_IMPLICIT else 0.0
+        q, v = _damped_mechanism(method, y, k1, h, inputs.viscous / model.dynamics.inertia, kappa)
         return State(q, v, ye.error_integral, ye.wires), 0, inputs
     half = 0.5 * h
     acc = k1

@@ -1,9 +1,15 @@
 """A run's numerical settings (integrator, step, PWM model): the ones given, or the run's default.
 
-A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets the long-step settings
-(exponential Euler, 5 ms, period-averaged PWM) where they were validated against a 1 us run
-with exact PWM edges (closed loop, and open loop under a program whose steps are at least
-0.5 s apart), and the reference settings (RK4, 1 ms, exact PWM) everywhere else. A
+A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets a long-step setting where it was
+validated against a run at a far shorter step with exact PWM edges, and the reference settings
+(RK4, 1 ms, exact PWM) everywhere else:
+
+- the rate-form stress law (the paper's joint): :data:`LONG_STEP`, exponential Euler, 5 ms,
+  period-averaged PWM, in closed loop and in open loop under a program whose steps are at
+  least 0.5 s apart;
+- the algebraic stress law (the linear bias-spring rig, the authors' 2020 model):
+  :data:`LONG_STEP_STIFF`, semi-implicit Euler with the wire's stiffness implicit too
+  (:func:`.integrators.load_stiffness`), 5 ms, period-averaged PWM, in open loop only. A
 run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where the long step holds and why it does not elsewhere:
 docs/speed.md.
@@ -17,7 +23,7 @@ import numpy as np
 
 from ..parameters.options import Hysteresis, JouleHeating, StressLaw
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
-                       LONG_STEP_PWM)
+                       LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
 
 #: an open-loop drive program with two steps closer than this keeps the reference [s]: the long
 #: step's first-order wire update drifts with every switch. An 80 % square wave at 8 V for 8 s
@@ -36,36 +42,54 @@ class Numerics:
 
 REFERENCE = Numerics(DEFAULT_METHOD, DEFAULT_DT_S, DEFAULT_PWM)
 LONG_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
+#: the algebraic stress law's long step: its stress follows q at once, and the wire's axial
+#: stiffness against the inertia is a fast, barely damped mode (about 1,200 rad/s on the linear
+#: rig) that exponential Euler, which takes only the damping implicitly, does not hold at any step
+LONG_STEP_STIFF = Numerics(LONG_STEP_STIFF_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
+
+
+def long_step(params) -> Numerics:
+    """The long-step setting of a parameter set's stress law (module docstring)."""
+    return LONG_STEP_STIFF if params.options.stress_law == StressLaw.ALGEBRAIC else LONG_STEP
 
 
 def long_step_refusal(params, controller, t_end_s: float, program=None) -> str | None:
-    """Why the long-step settings are not this run's default (None: they are).
+    """Why no long-step setting is this run's default (None: :func:`long_step` is).
 
-    Validated (benchmarks/bench_speed.py; every paper2010 scenario within 0.08 deg RMS of a
-    0.1 ms RK4 run, the full cycle 0.013 deg) for:
+    Validated (benchmarks/bench_speed.py, tests/test_numerics.py) for:
 
-    - the finger joint, the rate-form stress law, the return-point-memory hysteresis;
-    - per-metre Joule heating (the paper's sets; ``whole-wire`` heating of
-      ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step);
-    - the paper's PWM-PID: ``controller`` None or ``pid`` (a prepared
-      :class:`~smafinger.control.params.ControllerParameters`); its gains are not checked;
-    - a PWM period no longer than the step (the average then covers whole periods);
-    - in open loop, a ``program`` (:class:`~smafinger.profiles.VoltageProgram`) whose steps
-      are :data:`PROGRAM_MIN_STEP_S` apart or more.
+    - the rate-form stress law: the finger joint (every paper2010 scenario within 0.08 deg RMS
+      of a 0.1 ms RK4 run, the full cycle 0.013 deg), per-metre Joule heating (``whole-wire``
+      heating of ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step), the
+      paper's PWM-PID (``controller`` None or ``pid``, a prepared
+      :class:`~smafinger.control.params.ControllerParameters`; its gains are not checked) or
+      open loop;
+    - the algebraic stress law in open loop: the linear rig (whole-wire heating, 0.04 mm RMS,
+      0.5 mm max over an 18 mm stroke) and the authors' 2020 joint. Not in closed loop: on the
+      linear rig the closed loop's reach times scatter by seconds between step sizes (RK4 at
+      0.1 ms against 20 us included), so no step can be checked against a converged run;
+    - either law: the return-point-memory hysteresis, a PWM period no longer than the step (the
+      average then covers whole periods), and in open loop a ``program``
+      (:class:`~smafinger.profiles.VoltageProgram`) whose steps are :data:`PROGRAM_MIN_STEP_S`
+      apart or more.
     """
     opts = params.options
     if not t_end_s >= LONG_STEP_DT_S:
         return f"t_end_s = {t_end_s:g} is shorter than the long step ({LONG_STEP_DT_S:g} s)"
-    if params.mechanism != "joint":
-        return f"mechanism {params.mechanism}: the wire pulls the load directly, a mode only short steps resolve"
-    if opts.stress_law != StressLaw.RATE:
-        return "the algebraic stress law has not been validated at long steps"
-    if opts.joule_heating != JouleHeating.PER_METRE:
-        return f"joule_heating {opts.joule_heating.label}: not validated at long steps (1.2 deg RMS on the full cycle)"
     if opts.hysteresis != Hysteresis.MEMORY:
         return f"hysteresis {opts.hysteresis.label}: its branch follows the PWM ripple the average removes"
-    if controller is not None and controller.label != "pid":
-        return f"controller {controller.label}: validated for the paper's PWM-PID only"
+    if opts.stress_law == StressLaw.ALGEBRAIC:
+        if program is None:
+            return ("the algebraic stress law in closed loop: not validated (on the linear rig its reach times scatter "
+                    "by seconds between step sizes)")
+    else:
+        if params.mechanism != "joint":
+            return f"mechanism {params.mechanism} with the rate law: the wire pulls the load directly, a mode only " \
+                   "short steps resolve"
+        if opts.joule_heating != JouleHeating.PER_METRE:
+            return f"joule_heating {opts.joule_heating.label}: not validated at long steps (1.2 deg RMS on the full cycle)"
+        if controller is not None and controller.label != "pid":
+            return f"controller {controller.label}: validated for the paper's PWM-PID only"
     if params.pwm_period_s > LONG_STEP_DT_S:
         return f"pwm_period_s = {params.pwm_period_s:g} is longer than the long step ({LONG_STEP_DT_S:g} s)"
     if program is not None and len(program.steps) > 1:
@@ -79,7 +103,7 @@ def choose(params, controller, t_end_s: float, method: str | None, dt_s: float |
            pwm: str | None, program=None) -> Numerics:
     """The run's numerics: the given values, else the run's default (module docstring)."""
     if method is None and dt_s is None and pwm is None:
-        return LONG_STEP if long_step_refusal(params, controller, t_end_s, program) is None else REFERENCE
+        return long_step(params) if long_step_refusal(params, controller, t_end_s, program) is None else REFERENCE
     return Numerics(REFERENCE.method if method is None else method,
                     REFERENCE.dt_s if dt_s is None else dt_s,
                     REFERENCE.pwm if pwm is None else pwm)

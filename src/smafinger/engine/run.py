@@ -411,11 +411,12 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         solver, RK4 with the PWM read at its stages; :mod:`.integrators`); the PWM drive
         resolved at its edges (``"exact"``) or its period-averaged power (``"averaged"``,
         valid when the PWM period is far below the wire's thermal time constant; :mod:`.pwm`).
-        None of them given: the long-step settings (exponential, 5 ms, averaged) where they
-        were validated (:func:`.numerics.long_step_refusal`: the finger joint, its rate law,
-        the memory rule, per-metre heating and the paper's PID; in open loop a program with
-        steps 0.5 s apart or more), else rk4, 1 ms, exact (docs/speed.md). Any of them given:
-        the others from rk4, 1 ms, exact.
+        None of them given: a long step (5 ms, averaged) where validated
+        (:func:`.numerics.long_step_refusal`, all with the memory rule and, in open loop, a
+        program with steps 0.5 s apart or more): exponential for the rate law (the finger
+        joint, per-metre heating, the paper's PID or open loop), semi-implicit for the
+        algebraic law (the linear rig; open loop only); else rk4, 1 ms, exact
+        (docs/speed.md). Any of them given: the others from rk4, 1 ms, exact.
     tol_deg, tol_m, hold_s : float
         A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
         actuator) for ``hold_s``.
