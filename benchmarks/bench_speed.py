@@ -58,25 +58,36 @@ from smafinger.parameters import get  # noqa: E402
 
 from oracle import simulate_baseline  # noqa: E402
 
-#: (label, params, strategy, profile, t_end_s, unit scale for the error, unit)
+#: (label, params, strategy, profile or open-loop program (keywords), t_end_s)
 CASES = (
     ("paper2010 co-operative full cycle", "paper2010", "cooperative", "0:-25,reach:-55,reach:-40", 45.0),
     ("linear bias-spring rig, closed loop", "linear-bias-spring", "cooperative", "0:0.010,15:0.004", 30.0),
+    ("linear bias-spring rig, open loop", "linear-bias-spring", "open-loop",
+     dict(voltage="0:0.6,6:0,12:0.4,18:0", drive="duty"), 25.0),
     ("authors2020 profile 2", "authors2020", "independent", "0:-25:upper,5:-55:both", 20.0),
+    ("authors2020 with the memory rule, open loop", "authors2020+memory", "open-loop",
+     dict(voltage="0:8:0,4:0:0,8:0:8,12:0:0"), 16.0),
 )
 TODAY = ("rk4", 1e-3, "exact")  # the reference numerics (engine.numerics.REFERENCE)
 FAST = ("exponential", 5e-3, "averaged")  # the long step (engine.numerics.LONG_STEP)
 SETTINGS = (TODAY, FAST, ("semi-implicit", 5e-3, "averaged"), ("exponential", 1e-2, "averaged"),
-            ("rk4", 1e-3, "averaged"))
+            ("rk4", 1e-3, "averaged"), ("rk4", 1e-4, "exact"))
 
 #: the legacy engine (commit ff21ad0), co-operative full cycle at rk4 / 1 ms, CPU time of run_spec,
 #: measured on this kind of machine (2 cores) interleaved with this engine (--legacy-src)
 LEGACY = {"kernel_ms": (15.2, 15.7), "rms_deg": 0.0056, "substeps": 83260}
 
 
-def _spec(params, strategy, profile, t_end, setting):
+def _params(name):
+    """A named set; ``NAME+memory``: the set with the return-point-memory hysteresis."""
+    base, _, rule = name.partition("+")
+    return get(base).replace(hysteresis=rule) if rule else get(base)
+
+
+def _spec(params, strategy, profile, t_end, setting=(None, None, None)):
     method, dt, pwm = setting
-    return make_spec(params, strategy, profile, t_end_s=t_end, dt_s=dt, method=method, pwm=pwm)
+    run = profile if isinstance(profile, dict) else {"profile": profile}
+    return make_spec(_params(params), strategy, t_end_s=t_end, dt_s=dt, method=method, pwm=pwm, **run)
 
 
 def _coordinate(r):
@@ -93,7 +104,7 @@ def _reached(r):
 
 
 def bench_case(label, params, strategy, profile, t_end, repeat, ref_dt) -> dict:
-    unit = "deg" if get(params).mechanism == "joint" else "mm"
+    unit = "deg" if _params(params).mechanism == "joint" else "mm"
     specs = {s: _spec(params, strategy, profile, t_end, s) for s in SETTINGS}
     for sp in specs.values():
         run_spec(sp)  # compile or load the cache, outside the timing
@@ -106,11 +117,11 @@ def bench_case(label, params, strategy, profile, t_end, repeat, ref_dt) -> dict:
     t0 = time.perf_counter()
     ref = run_spec(_spec(params, strategy, profile, t_end, ("rk4", ref_dt, "exact")))
     t_ref = time.perf_counter() - t0
-    print(f"\n== {label}: {params}, {strategy}, '{profile}', {t_end:g} s simulated")
+    print(f"\n== {label}: {params}, {strategy}, {profile!r}, {t_end:g} s simulated")
     print(f"   reference: rk4 {ref_dt * 1e6:g} us, exact PWM ({ref.substeps} sub-steps, {t_ref:.0f} s); "
           f"reached {_reached(ref)}")
     base = min(walls[TODAY])
-    default = make_spec(params, strategy, profile, t_end_s=t_end)
+    default = _spec(params, strategy, profile, t_end)
     default = (default.method, default.dt_s, default.pwm)
     out = {}
     for s in SETTINGS:
