@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from smafinger.engine import interpreted
-from smafinger.engine.run import _kernels, _prepared, make_spec, run_spec
+from smafinger.engine.compiled import kernels
+from smafinger.engine.run import _prepared, make_spec, run_spec
 from smafinger.paper import scenarios
 from smafinger.parameters import get
 
@@ -102,7 +103,7 @@ def test_a_loaded_kernel_counts_as_cached():
     spec = scenarios.get("fig12-extension-v1").spec()
     run_spec(spec)
     call_args, key = _prepared(spec)[:2]
-    assert _kernels.cached(key, call_args)
+    assert kernels.cached(key, call_args)
 
 
 def _index_has_kernel(cache_dir: Path) -> bool:

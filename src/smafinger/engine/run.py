@@ -10,7 +10,6 @@ from dataclasses import dataclass
 from pathlib import PurePath
 
 import numpy as np
-from numba import config as numba_config, typeof
 
 from ..control.params import ControllerParameters, controller_from
 from ..control.strategies import STRATEGIES, enable_mask
@@ -20,16 +19,13 @@ from ..progress import Display
 from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
 from . import integrators, interpreted, numerics, pwm as pwm_models
-from .kernel import Program, RunSettings, run_kernel
+from .compiled import INTERPRETED, kernels
+from .kernel import Program, RunSettings
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M  # noqa: F401
 from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
 
-
-
-#: numba's JIT is disabled in this process: the kernel runs as Python (:mod:`.interpreted`)
-INTERPRETED = bool(numba_config.DISABLE_JIT)
 
 
 class SimulationError(RuntimeError):
@@ -242,48 +238,6 @@ def kernel_args(spec: RunSpec) -> dict:
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
-class _CompiledKernels:
-    """The kernel compiled (or loaded from numba's cache) once per mechanism, then called directly.
-
-    numba types every argument at every call, and typing the nested records costs about a
-    millisecond; their types depend only on the mechanism and the controller's record type
-    (every value is a float, every option an enum member), so the entry point is looked up once
-    per mechanism, wire count and controller (:func:`kernel_key`). With numba's JIT disabled
-    (the interpreted engine, :mod:`.interpreted`) the kernel is its Python function.
-    """
-
-    def __init__(self) -> None:
-        self._entry: dict[tuple, object] = {}
-
-    def __call__(self, key: tuple, args: tuple):
-        fn = self._entry.get(key)
-        if fn is None and INTERPRETED:
-            fn = self._entry[key] = run_kernel
-        if fn is None:
-            sig = tuple(typeof(a) for a in args)
-            run_kernel.compile(sig)
-            fn = self._entry[key] = run_kernel.overloads[sig].entry_point
-        return fn
-
-    def cached(self, key: tuple, args: tuple) -> bool:
-        """Is the kernel for these arguments loaded, or in numba's cache (so no compile is needed)?
-
-        Reads the cache's index as numba's ``Dispatcher.compile`` does before compiling; if
-        that fails (another numba version), says yes: the caller then compiles as before.
-        """
-        if key in self._entry or INTERPRETED:
-            return True
-        try:
-            sig = tuple(typeof(a) for a in args)
-            cache = run_kernel._cache
-            run_kernel.targetctx.refresh()
-            index = cache._cache_file._load_index()
-            return cache._index_key(sig, run_kernel.targetctx.codegen()) in index
-        except Exception:  # noqa: BLE001 - a numba internal changed: compile as before
-            return True
-
-
-_kernels = _CompiledKernels()
 
 
 def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
@@ -312,7 +266,7 @@ def kernel_key(spec: RunSpec) -> tuple:
 def compile_kernel(spec: RunSpec) -> None:
     """Compile the kernel ``spec`` needs (or load it from numba's cache), without running it."""
     call_args, key = _prepared(spec)[:2]
-    _kernels(key, call_args)
+    kernels(key, call_args)
 
 
 def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResult:
@@ -325,11 +279,11 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
     """
     call_args, key, mech, wires, seg_actual, seg_reached = _prepared(spec)
     if engine != "compiled" and not INTERPRETED:
-        if interpreted.choose(engine, _kernels.cached(key, call_args), spec) == "interpreted":
+        if interpreted.choose(engine, kernels.cached(key, call_args), spec) == "interpreted":
             if engine == "auto":
                 interpreted.build_in_background(spec)
             return interpreted.run_interpreted(spec)
-    kernel = _kernels(key, call_args)  # compiles outside the timing
+    kernel = kernels(key, call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress is True or isinstance(progress, Display):
         counters, state, t_fail = _run_with_progress(lambda: kernel(*call_args), mech, spec.t_end_s, progress)
