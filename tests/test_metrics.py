@@ -19,6 +19,18 @@ def test_window_includes_its_edges_within_half_a_tick():
     assert M.window(t, 1.0, 2.0).tolist() == [False, True, True, True, False]
 
 
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(0, 50), dt=st.sampled_from([1e-3, 5e-3, 0.1]), a=st.floats(-1.0, 6.0), width=st.floats(0.0, 6.0),
+       nudge=st.sampled_from([0.0, 0.4e-9, -0.4e-9, 0.6e-9]))
+def test_window_slice_picks_the_samples_of_the_window(n, dt, a, width, nudge):
+    """On an ascending output grid the bisected slice holds exactly the window's samples,
+    edges within half a tick included (the segment metrics use the slice)."""
+    t = np.arange(n) * dt
+    a = round(a / dt) * dt + nudge  # starts on and beside samples too
+    b = a + width
+    np.testing.assert_array_equal(t[M.window_slice(t, a, b)], t[M.window(t, a, b)])
+
+
 def test_overshoot_is_measured_in_the_direction_of_the_motion():
     th = np.array([-40.0, -35.0, -29.5, -30.2, -30.0])
     assert M.overshoot_deg(th, -30.0, M.motion_direction(-40.0, -30.0)) == pytest.approx(0.5)

@@ -126,8 +126,9 @@ def _damped_mechanism(method, y, k1, h, c, kappa):
 
     v' = a - c v with a = k1.v + c v held over the step. ``semi-implicit``: v1 = v + h k1.v /
     (1 + c h), q1 = q + h v1; with a stiffness kappa > 0 (a = a0 - kappa (q - q0)),
-    v1 = v + h (k1.v - kappa h v) / (1 + c h + kappa h^2). ``exponential``: v1 = v + h phi1(-c h) k1.v and q1 = q + h q' +
-    h^2 phi2(-c h) k1.v (exact for a constant a). A stuck mechanism has q' = v' = 0: it stays.
+    v1 = v + h (k1.v - kappa h v) / (1 + c h + kappa h^2). ``exponential``: v1 = v +
+    h phi1(-c h) k1.v and q1 = q + h q' + h^2 phi2(-c h) k1.v (exact for a constant a). A stuck
+    mechanism has q' = v' = 0: it stays.
     """
     if method == Method.SEMI_IMPLICIT:
         if kappa > 0.0:  # the stiffness implicit too: v1 (1 + c h + kappa h^2) = v (1 + c h) + h q''

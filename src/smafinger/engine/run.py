@@ -238,8 +238,6 @@ def kernel_args(spec: RunSpec) -> dict:
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
-
-
 def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
     mo, wo = kernel_views(mech, wires)
     return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
