@@ -259,10 +259,10 @@ def bench_first_result(run: str, env: dict) -> None:
         env = {k: v for k, v in env.items() if k != "SMAFINGER_ENGINE"}
         t0 = time.perf_counter()
         first_s = _process_s(run, dict(env, NUMBA_CACHE_DIR=tmp), repeat=1)
-        while not any(Path(tmp).rglob("kernel.run_kernel-*.nbi")) and time.perf_counter() - t0 < 900:
+        # numba writes the index, then the kernel's data file (atomically, by a rename)
+        while not any(Path(tmp).rglob("kernel.run_kernel-*.nbc")) and time.perf_counter() - t0 < 900:
             time.sleep(0.5)
         ready_s = time.perf_counter() - t0
-        time.sleep(2.0)  # numba writes the index, then the kernel
         after_s = _process_s(run, dict(env, NUMBA_CACHE_DIR=tmp), repeat=1)
     with tempfile.TemporaryDirectory() as tmp:
         compiled_s = _process_s(run, dict(env, NUMBA_CACHE_DIR=tmp, SMAFINGER_ENGINE="compiled"), repeat=1)

@@ -6,7 +6,7 @@ import pytest
 os.environ.setdefault("MPLBACKEND", "Agg")
 # the compiled kernel in every test (a cold cache would otherwise answer some runs interpreted and
 # start background compiles); tests/test_interpreted.py chooses its engines itself
-os.environ.setdefault("SMAFINGER_ENGINE", "compiled")
+os.environ["SMAFINGER_ENGINE"] = "compiled"
 
 #: the repository (the folder holding tests/)
 REPO = Path(__file__).resolve().parents[1]

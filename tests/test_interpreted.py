@@ -20,9 +20,10 @@ from smafinger.parameters import get
 
 CYCLE = ("paper2010", "cooperative", "0:-25,reach:-55,reach:-40")
 
-#: one run per kernel variant and integrator family: the paper's full cycle at the long step,
-#: its Table II open-loop run at rk4 with the PWM resolved, the linear rig (algebraic stress
-#: law, slider), the authors' solver on authors2020, a built-in controller (ControlChain)
+#: one run per kernel variant and integrator: the paper's full cycle at the long step
+#: (exponential), its Table II open-loop run at rk4 with the PWM resolved, the linear rig
+#: (algebraic stress law, slider) in closed loop at rk4 and in open loop at its long step
+#: (semi-implicit), the authors' solver on authors2020, a built-in controller (ControlChain), euler
 CASES = {
     "full-cycle-long-step": lambda: make_spec(*CYCLE, t_end_s=45.0),
     "open-loop-rk4": lambda: make_spec("paper2010-table2", "open-loop", voltage="0:8:0,3:0:8", t_end_s=6.0),
@@ -30,6 +31,10 @@ CASES = {
     "authors-ode4": lambda: make_spec("authors2020", "independent", "0:-25:upper,5:-55:both", t_end_s=8.0,
                                       method="authors-ode4"),
     "fuzzy-pid": lambda: make_spec("paper2010", "cooperative", "0:-25,6:-55", t_end_s=10.0, controller="fuzzy-pid"),
+    # the linear rig's open-loop default: semi-implicit with the wire's stiffness implicit
+    "linear-rig-long-step": lambda: make_spec("linear-bias-spring", "open-loop", voltage="0:0.6,3:0", drive="duty",
+                                              t_end_s=6.0),
+    "euler": lambda: make_spec("paper2010", "cooperative", "0:-25", t_end_s=3.0, method="euler", dt_s=2e-4),
 }
 
 
@@ -51,14 +56,21 @@ def test_the_interpreted_engine_gives_the_compiled_results_to_rounding(case):
         np.testing.assert_allclose(x, y, rtol=0, atol=1e-9 * scale, err_msg=col)
 
 
-def test_a_blow_up_interpreted_names_the_time_and_the_state():
-    """The child's SimulationError reaches the caller, as the compiled kernel's does."""
+@pytest.mark.parametrize("case", ["overflow", "math-domain"])
+def test_a_blow_up_interpreted_names_the_time_and_the_state(case):
+    """The child's SimulationError reaches the caller, as the compiled kernel's does; Python's
+    ``math`` raising (an overflow, cos(inf) in an RK4 stage) is the blow-up it stands for."""
     from smafinger.engine.run import SimulationError
 
-    p = get("paper2010").replace(inertia_kg_m2=1e-9)  # as tests/test_engine.py's blow-up
-    spec = make_spec(p, "open-loop", voltage="0:8:0", t_end_s=5.0, dt_s=1e-3)
+    if case == "overflow":
+        p = get("paper2010").replace(inertia_kg_m2=1e-9)  # as tests/test_engine.py's blow-up
+        spec, coordinate = make_spec(p, "open-loop", voltage="0:8:0", t_end_s=5.0, dt_s=1e-3), "theta_rad"
+    else:
+        p = get("linear-bias-spring").replace(slider_mass_kg=1e-6)
+        spec = make_spec(p, "open-loop", voltage="0:0.6", drive="duty", t_end_s=6.0, method="rk4", dt_s=5e-3)
+        coordinate = "position_m"
     for engine in ("compiled", "interpreted"):
-        with pytest.raises(SimulationError, match=r"blow-up at t = .* theta_rad="):
+        with pytest.raises(SimulationError, match=rf"blow-up at t = .* {coordinate}="):
             run_spec(spec, engine=engine)
 
 
@@ -66,7 +78,9 @@ def test_auto_interprets_only_a_short_run_without_a_cached_kernel():
     short = make_spec(*CYCLE, t_end_s=45.0)  # the long step: 1.3 s estimated
     reference = make_spec(*CYCLE, t_end_s=45.0, method="rk4")  # 25 s estimated
     long = make_spec(*CYCLE, t_end_s=300.0, method="rk4")
-    assert interpreted.interpreted_estimate_s(short) == pytest.approx(45.0 / 5e-3 * interpreted.S_PER_STAGE)
+    assert interpreted.interpreted_estimate_s(short) < 2.0  # measured 1.2 s
+    # the PWM's edges count: rk4 at 1 ms, exact, is 83,282 sub-steps, not 45,000 (measured 14.2 s)
+    assert 14.2 < interpreted.interpreted_estimate_s(reference) < interpreted.INTERPRETED_LIMIT_S
     assert interpreted.choose("auto", False, short) == "interpreted"
     assert interpreted.choose("auto", False, reference) == "interpreted"
     assert interpreted.choose("auto", False, long) == "compiled"
@@ -99,11 +113,50 @@ def test_a_bad_engine_in_the_environment_is_a_usage_error(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_loaded_kernel_counts_as_cached():
+def test_a_kernel_in_numbas_cache_counts_as_cached():
+    """A fresh lookup table (as in a new process) finds the kernel on disk once it was compiled."""
+    from smafinger.engine.compiled import CompiledKernels
+
     spec = scenarios.get("fig12-extension-v1").spec()
     run_spec(spec)
     call_args, key = _prepared(spec)[:2]
-    assert kernels.cached(key, call_args)
+    assert kernels.cached(key, call_args) and CompiledKernels().cached(key, call_args)
+
+
+def test_the_command_line_engine_option(tmp_path):
+    from smafinger.cli import main
+
+    out = tmp_path / "s.json"
+    assert main(["simulate", "--profile", "0:-25", "--t-end", "2", "--no-progress", "--engine", "interpreted",
+                 "--summary", str(out)]) == 0
+    assert json.loads(out.read_text())["engine"] == "interpreted"
+    with pytest.raises(ValueError, match="engine = 'jit'"):
+        run_spec(make_spec(*CYCLE, t_end_s=1.0), engine="jit")
+
+
+def test_the_interpreted_child_imports_the_callers_package(tmp_path):
+    """The child gets this process's sys.path: it imports this very package (a copy first on the
+    path, not an installed one), from any folder, with numba's JIT disabled."""
+    import smafinger
+
+    code = "import smafinger, numba; print(smafinger.__file__); print(numba.config.DISABLE_JIT)"
+    out = subprocess.run([sys.executable, "-c", code], env=interpreted.child_env("run"), cwd=tmp_path,
+                         capture_output=True, text=True, check=True).stdout.split()
+    assert out == [smafinger.__file__, "1"]
+
+
+def test_auto_compiles_when_the_child_fails(monkeypatch):
+    spec = make_spec(*CYCLE, t_end_s=1.0)
+
+    def broken(_spec):
+        raise interpreted.InterpretedFailure("the child could not start")
+
+    monkeypatch.setattr(interpreted, "run_interpreted", broken)
+    monkeypatch.setattr(interpreted, "build_in_background", lambda _spec: None)
+    monkeypatch.setattr(interpreted, "choose", lambda engine, cached, spec: "interpreted")
+    assert run_spec(spec, engine="auto").engine == "compiled"
+    with pytest.raises(interpreted.InterpretedFailure):
+        run_spec(spec, engine="interpreted")
 
 
 def _index_has_kernel(cache_dir: Path) -> bool:
@@ -117,7 +170,7 @@ def _wait_for_build(spec, cache_dir):
     old = os.environ.get("NUMBA_CACHE_DIR")
     os.environ["NUMBA_CACHE_DIR"] = cache_dir
     try:
-        path = interpreted._lock_path(spec)
+        path = interpreted._build_path(spec, ".lock")
     finally:
         if old is None:
             del os.environ["NUMBA_CACHE_DIR"]

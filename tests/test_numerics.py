@@ -36,7 +36,8 @@ REF = (REFERENCE.method, REFERENCE.dt_s, REFERENCE.pwm)
     (dict(params="linear-bias-spring", strategy="open-loop", **LINEAR_PROGRAM), STIFF),
     (dict(params="linear-bias-spring", strategy="open-loop", voltage="0:0.6,0.2:0", drive="duty"), REF),
     (dict(params="authors2020", strategy="open-loop", voltage="0:8:0"), REF),
-    (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="open-loop", voltage="0:8:0"), STIFF),
+    (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="open-loop", voltage="0:8:0"), LONG),
+    (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="independent", profile="0:-25"), REF),
     (dict(params="authors2020", strategy="independent", profile="0:-25:upper"), REF),
     (dict(params=get("paper2010").replace(hysteresis="deadband"), strategy="cooperative", profile="0:-30"), REF),
     (dict(params=get("paper2010").replace(pwm_period_s=0.01), strategy="cooperative", profile="0:-30"), REF),
@@ -93,13 +94,15 @@ def test_the_linear_rigs_default_open_loop_run_is_within_its_budget():
 
 def test_the_algebraic_laws_long_step_on_the_authors_joint():
     """authors2020's mechanics (the algebraic law on the finger joint) with the memory rule, open
-    loop, against RK4 at 0.1 ms. With its own rule (the branch follows the sign of dT/dt, which
-    the PWM ripple flips every period) the average changes the result: the default refuses it."""
+    loop, against RK4 at 0.1 ms (measured 0.013 deg RMS, 0.063 max with exponential Euler; the
+    slider's semi-implicit gave 0.028, 0.108). With its own rule (the branch follows the sign of
+    dT/dt, which the PWM ripple flips every period) the average changes the result: the default
+    refuses it."""
     p = get("authors2020").replace(hysteresis="memory")
     kw = dict(voltage="0:8:0,4:0:0,8:0:8,12:0:0", t_end_s=16.0)
     fast = simulate(p, "open-loop", **kw)
     ref = simulate(p, "open-loop", **kw, dt_s=1e-4)
-    assert _numerics(fast.spec) == STIFF
+    assert _numerics(fast.spec) == LONG
     err = fast.theta_deg - ref.theta_deg
     assert np.ptp(ref.theta_deg) > 10.0
     assert np.sqrt(np.mean(err ** 2)) < 0.05 and np.max(np.abs(err)) < 0.3, (np.sqrt(np.mean(err ** 2)),

@@ -40,7 +40,8 @@ def wire_strain(sigma_Pa: np.ndarray, xi: np.ndarray, D_A_Pa: float, D_M_Pa: flo
     """The wire's strain sigma / D(xi) + xi eps_R (Eq. 7a with theta_T = 0)."""
     from .model.constitutive import youngs_modulus
 
-    return sigma_Pa / youngs_modulus.py_func(xi, D_A_Pa, D_M_Pa) + xi * eps_R
+    modulus = getattr(youngs_modulus, "py_func", youngs_modulus)  # the plain function (numpy arrays)
+    return sigma_Pa / modulus(xi, D_A_Pa, D_M_Pa) + xi * eps_R
 
 
 def _peak(values: np.ndarray, t: np.ndarray) -> tuple[float, float]:

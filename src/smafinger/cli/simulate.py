@@ -16,8 +16,9 @@ from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 #: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
 NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step, {LONG_STEP_DT_S:g} s, {LONG_STEP_PWM}, "
                  f"where validated (the memory rule; in open loop a program with steps 0.5 s apart or more): "
-                 f"{LONG_STEP_METHOD} for the finger joint's rate law with per-metre heating and the paper's PID or "
-                 f"open loop, {LONG_STEP_STIFF_METHOD} for the algebraic law (the linear rig) in open loop; "
+                 f"{LONG_STEP_METHOD} for the finger joint (its rate law with per-metre heating and the paper's PID "
+                 f"or open loop; the algebraic law in open loop), {LONG_STEP_STIFF_METHOD} for the linear rig in "
+                 f"open loop; a PWM period of 5 ms or less; "
                  f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
                  f"{DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
 
@@ -99,9 +100,11 @@ def simulate(
     from .show import print_run
 
     print_run(result)
+    from ..engine.compiled import INTERPRETED
+
     if result.engine == "interpreted":
         print(f"smafinger: note: this run was interpreted ({result.wall_s:.1f} s; the same equations as the compiled "
-              "kernel, equal to rounding)" + ("" if setting != "auto" else
+              "kernel, equal to rounding)" + ("" if setting != "auto" or INTERPRETED else
                                              ": the compiled kernel was not in numba's cache, and is being compiled "
                                              "in the background for the runs that follow"), file=sys.stderr)
 

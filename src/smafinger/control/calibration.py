@@ -98,7 +98,7 @@ def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strateg
     qs, Rs, R_ref = [], [], None
     for target in targets:
         r = simulate(p, strategy, f"0:{target:g}", t_end_s=STEP_S, output_interval_s=output_interval_s,
-                     dt_s=DEFAULT_DT_S)  # the reference numerics (engine.numerics): the PWM resolved
+                     dt_s=DEFAULT_DT_S, engine="compiled")  # the reference numerics: the PWM resolved
         R = np.column_stack([r.signal(f"R_{w}_ohm") for w in p.wire_names])
         R_ref = R[0] if R_ref is None else R_ref
         keep = r.t >= SETTLE_S

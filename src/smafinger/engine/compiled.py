@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 from numba import config as numba_config, typeof
 
 from .kernel import run_kernel
@@ -36,8 +38,9 @@ class CompiledKernels:
     def cached(self, key: tuple, args: tuple) -> bool:
         """Is the kernel for these arguments loaded, or in numba's cache (so no compile is needed)?
 
-        Reads the cache's index as numba's ``Dispatcher.compile`` does before compiling; if
-        that fails (another numba version), says yes: the caller then compiles as before.
+        Reads the cache's index as numba's ``Dispatcher.compile`` does before compiling, and
+        checks that the kernel's data file is there too (numba writes the index first); if that
+        fails (another numba version), says yes: the caller then compiles as before.
         """
         if key in self._entry or INTERPRETED:
             return True
@@ -46,7 +49,8 @@ class CompiledKernels:
             cache = run_kernel._cache
             run_kernel.targetctx.refresh()
             index = cache._cache_file._load_index()
-            return cache._index_key(sig, run_kernel.targetctx.codegen()) in index
+            data = index.get(cache._index_key(sig, run_kernel.targetctx.codegen()))
+            return data is not None and os.path.exists(os.path.join(cache._cache_path, data))
         except Exception:  # noqa: BLE001 - a numba internal changed: compile as before
             return True
 

@@ -22,7 +22,7 @@ DEFAULT_PWM = "exact"
 LONG_STEP_DT_S = 5e-3
 LONG_STEP_METHOD = "exponential"
 LONG_STEP_PWM = "averaged"
-#: the algebraic stress law's (engine.numerics.LONG_STEP_STIFF): its stiffness implicit too
+#: the linear rig's (a slider, engine.numerics.LONG_STEP_STIFF): the wire's stiffness implicit too
 LONG_STEP_STIFF_METHOD = "semi-implicit"
 
 #: the engines a single run may use (engine.interpreted); the default comes from ENGINE_ENV, else "auto"

@@ -11,8 +11,10 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
   mechanism): stable at any step against the damping; the next-stiffest mode is about 34 1/s.
   With the algebraic stress law the wire's stiffness is implicit too (linearized by a forward
   difference, :func:`load_stiffness`): there the stress follows q at once, and the wire's axial
-  stiffness against the inertia is a fast, barely damped mode (about 1,200 rad/s on the linear
-  rig) that made every explicit update of q unstable above about 1.7 ms.
+  stiffness against the inertia is a fast, barely damped mode (on the linear rig omega =
+  sqrt(kappa) = 527 rad/s at rest in martensite, more as the wire turns stiffer austenite)
+  that no explicit update of q holds (Euler and exponential Euler drift off at every step;
+  semi-implicit without it held 2 ms steps, not 5 ms: 2/omega = 3.8 ms at rest).
 - ``exponential``: exponential Euler for the mechanism: (q, v) advanced exactly under the held
   load with the damping C_DF (phi functions), the wires by Euler. Like ``semi-implicit`` but
   exact for the damped motion under a constant load.
@@ -109,12 +111,12 @@ def load_stiffness(model, y, inputs, k1):
     """kappa = -d(q'')/dq at the state's v and wire states [1/s^2]: the mechanism's stiffness
     over its inertia, by a forward difference, >= 0. Only with the algebraic stress law (authors'
     2020 model), where a wire's stress follows q at once: the wire's axial stiffness against the
-    inertia is then a fast undamped mode (about 1,200 rad/s on the linear rig). With the rate law
+    inertia is then a fast undamped mode (527 rad/s on the linear rig at rest). With the rate law
     the stress is a state and q'' depends on q through the geometry alone: 0.
     """
     if model.options.stress_law != StressLaw.ALGEBRAIC or inputs.stuck:
         return 0.0
-    dq = 1e-7 * (1e-3 + abs(y.q))
+    dq = 1e-7 * (1e-3 + abs(y.q))  # a relative step near sqrt(machine epsilon) of q [rad or m]
     q = y.q + dq
     k, _ = derivative(State(q, y.v, y.error_integral, y.wires), inputs, model, geometry(model, q))
     return max(0.0, -(k.v - k1.v) / dq)

@@ -16,7 +16,8 @@ default comes from the environment variable ``SMAFINGER_ENGINE``, else ``auto``)
 - ``auto``: the compiled kernel if it is cached; otherwise the run interpreted when
   :func:`interpreted_estimate_s` is at most :data:`INTERPRETED_LIMIT_S`, with the kernel
   compiled meanwhile by a detached background process (one per kernel at a time) for the runs
-  that follow; a longer run compiles first.
+  that follow; a longer run compiles first, and so does a run whose child process fails
+  (:class:`InterpretedFailure`: the package not importable there, say).
 """
 
 from __future__ import annotations
@@ -31,12 +32,17 @@ from pathlib import Path
 
 from . import integrators
 from .defaults import ENGINE_ENV, ENGINES
-#: interpreted cost per integrator stage of a step [s]: measured on a 2-core machine, the
-#: paper's full cycle (45 s) took 1.2 s at the long step (9,000 one-stage steps: 133 us) and
-#: 14.2 s at rk4 1 ms (45,000 four-stage steps and their PWM edges: 79 us); the larger is used
-S_PER_STAGE = 140e-6
+#: interpreted cost of a sub-step [s], and of each integrator stage in it (a conservative fit to
+#: the paper's full cycle, 45 s, on a 2-core machine: 1.2 s at the long step, 9,003 one-stage
+#: sub-steps, estimated 1.2 s; 14.2 s at rk4 1 ms, 83,282 four-stage sub-steps, estimated 24 s)
+S_PER_SUBSTEP = 90e-6
+S_PER_STAGE = 45e-6
 #: ``auto`` interprets a run estimated to take at most this long [s]; a kernel compiles in 40-50 s
 INTERPRETED_LIMIT_S = 30.0
+
+
+class InterpretedFailure(RuntimeError):
+    """The interpreted engine's child process failed (not the run: a blow-up is a SimulationError)."""
 
 
 def engine_setting(engine: str | None) -> str:
@@ -50,8 +56,12 @@ def engine_setting(engine: str | None) -> str:
 
 
 def interpreted_estimate_s(spec) -> float:
-    """The interpreted run's expected duration [s]: steps x the integrator's stages x :data:`S_PER_STAGE`."""
-    return spec.t_end_s / spec.dt_s * integrators.get(spec.method).stages * S_PER_STAGE
+    """The interpreted run's expected duration [s] from its sub-steps: one per step and, with the
+    PWM resolved at its edges, about one more per PWM period (its duty edge)."""
+    substeps = spec.t_end_s / spec.dt_s
+    if spec.pwm == "exact":
+        substeps += spec.t_end_s / spec.params.pwm_period_s
+    return substeps * (S_PER_SUBSTEP + integrators.get(spec.method).stages * S_PER_STAGE)
 
 
 def choose(engine: str, cached: bool, spec) -> str:
@@ -64,14 +74,21 @@ def choose(engine: str, cached: bool, spec) -> str:
     return "interpreted"
 
 
-def _child(mode: str) -> subprocess.Popen:
+def child_env(mode: str) -> dict:
+    """The environment of a child process: this one's, with this process's ``sys.path`` (so that
+    it imports the package this process imported), and numba's JIT disabled to ``run``."""
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"}
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
     if mode == "run":
         env["NUMBA_DISABLE_JIT"] = "1"
+    return env
+
+
+def _child(mode: str, stderr=subprocess.PIPE) -> subprocess.Popen:
+    """``python -m`` this module in ``mode`` (:func:`child_env`); a ``build`` is detached from this process."""
     detached = mode == "build"
-    return subprocess.Popen([sys.executable, "-m", __name__, mode], env=env, stdin=subprocess.PIPE,
-                            stdout=subprocess.DEVNULL if detached else subprocess.PIPE,
-                            stderr=subprocess.DEVNULL if detached else subprocess.PIPE,
+    return subprocess.Popen([sys.executable, "-m", __name__, mode], env=child_env(mode), stdin=subprocess.PIPE,
+                            stdout=subprocess.DEVNULL if detached else subprocess.PIPE, stderr=stderr,
                             start_new_session=detached)
 
 
@@ -82,11 +99,19 @@ def run_interpreted(spec):
     blow-up, with the time and the state).
     """
     proc = _child("run")
-    out, err = proc.communicate(pickle.dumps(spec))
+    try:
+        out, err = proc.communicate(pickle.dumps(spec))
+    except BaseException:  # an interrupt (Ctrl-C in a notebook reaches this process only)
+        proc.kill()
+        proc.wait()
+        raise
     if proc.returncode != 0 or not out:
-        raise RuntimeError(f"the interpreted engine's process failed (exit status {proc.returncode}): "
-                           f"{err.decode(errors='replace').strip()[-2000:]}")
-    status, value = pickle.loads(out)
+        raise InterpretedFailure(f"the interpreted engine's process failed (exit status {proc.returncode}): "
+                                 f"{err.decode(errors='replace').strip()[-2000:]}")
+    try:
+        status, value = pickle.loads(out)
+    except Exception as exc:  # noqa: BLE001 - a garbled answer
+        raise InterpretedFailure(f"the interpreted engine's answer could not be read: {exc}") from None
     if status == "error":
         raise value
     return value
@@ -94,17 +119,23 @@ def run_interpreted(spec):
 
 def build_in_background(spec) -> None:
     """Compile (into numba's cache) the kernel ``spec`` needs, in a detached process that outlives
-    this one; it does nothing if another process is compiling the same kernel."""
-    proc = _child("build")
-    proc.stdin.write(pickle.dumps(spec))
-    proc.stdin.close()
+    this one; it does nothing if another process is compiling the same kernel. What it prints
+    (a failed compile) goes to ``<temp>/smafinger-build-<user>-<kernel>.log``."""
+    try:
+        with open(_build_path(spec, ".log"), "wb") as log:
+            proc = _child("build", stderr=log)
+        proc.stdin.write(pickle.dumps(spec))
+        proc.stdin.close()
+    except OSError:  # no log or no child: the next run compiles, as before this module
+        return
 
 
-def _lock_path(spec) -> Path:
-    """A lock file per kernel and numba cache folder (one build at a time)."""
+def _build_path(spec, suffix: str) -> Path:
+    """A file per user, kernel, numba cache folder and Python (one build at a time): the lock, the log."""
     from .run import kernel_key
-    key = repr((kernel_key(spec), os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable))
-    return Path(tempfile.gettempdir()) / f"smafinger-build-{hashlib.sha1(key.encode()).hexdigest()[:16]}.lock"
+    key = repr((kernel_key(spec), os.environ.get("NUMBA_CACHE_DIR", ""), sys.executable, sys.path))
+    user = os.getuid() if hasattr(os, "getuid") else os.getlogin()
+    return Path(tempfile.gettempdir()) / f"smafinger-build-{user}-{hashlib.sha1(key.encode()).hexdigest()[:16]}{suffix}"
 
 
 def _build(spec) -> None:
@@ -114,7 +145,7 @@ def _build(spec) -> None:
     except ImportError:  # not POSIX: no lock
         compile_kernel(spec)
         return
-    with open(_lock_path(spec), "w") as lock:
+    with open(_build_path(spec, ".lock"), "w") as lock:
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -122,10 +153,11 @@ def _build(spec) -> None:
         compile_kernel(spec)
 
 
-def _overflow_error(spec, exc: OverflowError):
-    """The :class:`~smafinger.engine.run.SimulationError` for an overflow: Python's ``math`` raises
-    where the compiled code gives Inf (which the kernel reports as a blow-up). The time and the
-    state are the kernel's at the start of the sub-step that overflowed (its frame's locals)."""
+def _blow_up(spec, exc: ArithmeticError | ValueError):
+    """The :class:`~smafinger.engine.run.SimulationError` for a math error inside the kernel, or
+    None if it was raised elsewhere. Python's ``math`` raises (an overflow, ``cos(inf)``) where
+    compiled code gives Inf or NaN, which the kernel reports as a blow-up; the time and the state
+    here are the kernel's at the start of the sub-step that failed (its frame's locals)."""
     from .run import SimulationError, describe_state
 
     tb, frame = exc.__traceback__, None
@@ -133,22 +165,22 @@ def _overflow_error(spec, exc: OverflowError):
         if tb.tb_frame.f_code.co_name == "run_kernel":
             frame = tb.tb_frame
         tb = tb.tb_next
-    if frame is None:
-        return SimulationError(f"numerical blow-up (overflow: {exc})")
+    if frame is None or "a" not in frame.f_locals:
+        return None
     t_s = frame.f_locals["a"] * frame.f_locals["run"].tick_s
-    return SimulationError(f"numerical blow-up at t = {t_s:.9g} s (an overflow, {exc}, in the sub-step from "
-                           f"there): {describe_state(spec.params, frame.f_locals['y'])}")
+    return SimulationError(f"numerical blow-up at t = {t_s:.9g} s ({type(exc).__name__}: {exc}, in the sub-step "
+                           f"from there): {describe_state(spec.params, frame.f_locals['y'])}")
 
 
 def _run(spec) -> tuple:
     from .run import run_spec
     try:
         return "ok", run_spec(spec, engine="compiled")
-    except OverflowError as exc:
-        return "error", _overflow_error(spec, exc)
     except Exception as exc:  # noqa: BLE001 - sent to the parent, which raises it
+        if isinstance(exc, (ArithmeticError, ValueError)):
+            exc = _blow_up(spec, exc) or exc
         try:
-            pickle.dumps(exc)
+            pickle.loads(pickle.dumps(exc))
         except Exception:  # noqa: BLE001
             exc = RuntimeError(f"{type(exc).__name__}: {exc}")
         return "error", exc
@@ -159,10 +191,12 @@ def _main(mode: str) -> None:
     if mode == "build":
         _build(spec)
         return
-    stdout, sys.stdout = sys.stdout, sys.stderr  # nothing but the result on stdout
+    result = os.fdopen(os.dup(1), "wb")  # the result's channel; anything else printed goes to stderr
+    os.dup2(2, 1)
+    sys.stdout = sys.stderr
     answer = _run(spec)
-    stdout.buffer.write(pickle.dumps(answer))
-    stdout.flush()
+    result.write(pickle.dumps(answer))
+    result.flush()
 
 
 if __name__ == "__main__":

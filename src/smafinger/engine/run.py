@@ -23,7 +23,7 @@ from .compiled import INTERPRETED, kernels
 from .kernel import Program, RunSettings
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
-from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M  # noqa: F401
+from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
 from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
 
 
@@ -275,12 +275,18 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
     a thread, so that Ctrl-C is answered at once). ``engine``: ``compiled``, ``interpreted`` or
     ``auto`` (:mod:`.interpreted`; an interpreted run shows no progress).
     """
+    if engine not in ENGINES:
+        raise ValueError(f"engine = {engine!r} is not one of {', '.join(ENGINES)}")
     call_args, key, mech, wires, seg_actual, seg_reached = _prepared(spec)
     if engine != "compiled" and not INTERPRETED:
         if interpreted.choose(engine, kernels.cached(key, call_args), spec) == "interpreted":
-            if engine == "auto":
-                interpreted.build_in_background(spec)
-            return interpreted.run_interpreted(spec)
+            if engine == "interpreted":
+                return interpreted.run_interpreted(spec)
+            interpreted.build_in_background(spec)
+            try:
+                return interpreted.run_interpreted(spec)
+            except interpreted.InterpretedFailure:
+                pass  # auto: compile here instead
     kernel = kernels(key, call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress is True or isinstance(progress, Display):
@@ -365,9 +371,9 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         valid when the PWM period is far below the wire's thermal time constant; :mod:`.pwm`).
         None of them given: a long step (5 ms, averaged) where validated
         (:func:`.numerics.long_step_refusal`, all with the memory rule and, in open loop, a
-        program with steps 0.5 s apart or more): exponential for the rate law (the finger
-        joint, per-metre heating, the paper's PID or open loop), semi-implicit for the
-        algebraic law (the linear rig; open loop only); else rk4, 1 ms, exact
+        program with steps 0.5 s apart or more): exponential on the finger joint (its rate law
+        with per-metre heating and the paper's PID or open loop; the algebraic law in open
+        loop), semi-implicit on the linear rig (open loop only); else rk4, 1 ms, exact
         (docs/speed.md). Any of them given: the others from rk4, 1 ms, exact.
     tol_deg, tol_m, hold_s : float
         A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
