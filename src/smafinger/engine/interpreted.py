@@ -18,6 +18,8 @@ default comes from the environment variable ``SMAFINGER_ENGINE``, else ``auto``)
   compiled meanwhile by a detached background process (one per kernel at a time) for the runs
   that follow; a longer run compiles first, and so does a run whose child process fails
   (:class:`InterpretedFailure`: the package not importable there, say).
+
+An interpreted run shows no progress bar.
 """
 
 from __future__ import annotations

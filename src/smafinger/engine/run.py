@@ -243,11 +243,12 @@ def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tupl
     return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
 
 
-def _prepared(spec: RunSpec) -> tuple:
-    """(kernel arguments, kernel key, mechanism and wire outputs, segment starts and reaches)."""
-    args = kernel_args(spec)
-    run = args["run"]
-    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, len(spec.params.wire_names))
+def _prepared(spec: RunSpec, args: dict | None = None, samples: int | None = None) -> tuple:
+    """(kernel arguments, kernel key, outputs, segment starts and reaches); ``samples=1``: arguments
+    of the same types without the run's outputs allocated (to look the kernel up)."""
+    args = kernel_args(spec) if args is None else args
+    n = args["run"].t_end_ticks // args["run"].out_ticks + 1 if samples is None else samples
+    mech, wires = new_outputs(n, len(spec.params.wire_names))
     n_seg = len(spec.profile.segments)
     seg_actual = np.full(n_seg, -1, dtype=np.int64)
     seg_reached = np.full(n_seg, -1, dtype=np.int64)
@@ -258,12 +259,12 @@ def _prepared(spec: RunSpec) -> tuple:
 
 def kernel_key(spec: RunSpec) -> tuple:
     """What the compiled kernel depends on: the mechanism, the wire count, the controller's record type."""
-    return _prepared(spec)[1]
+    return _prepared(spec, samples=1)[1]
 
 
 def compile_kernel(spec: RunSpec) -> None:
     """Compile the kernel ``spec`` needs (or load it from numba's cache), without running it."""
-    call_args, key = _prepared(spec)[:2]
+    call_args, key = _prepared(spec, samples=1)[:2]
     kernels(key, call_args)
 
 
@@ -272,14 +273,13 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
 
     ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
     :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
-    a thread, so that Ctrl-C is answered at once). ``engine``: ``compiled``, ``interpreted`` or
-    ``auto`` (:mod:`.interpreted`; an interpreted run shows no progress).
-    """
+    a thread, so that Ctrl-C is answered at once). ``engine``: see :mod:`.interpreted`."""
     if engine not in ENGINES:
         raise ValueError(f"engine = {engine!r} is not one of {', '.join(ENGINES)}")
-    call_args, key, mech, wires, seg_actual, seg_reached = _prepared(spec)
+    args = kernel_args(spec)
     if engine != "compiled" and not INTERPRETED:
-        if interpreted.choose(engine, kernels.cached(key, call_args), spec) == "interpreted":
+        probe, key = _prepared(spec, args, samples=1)[:2]  # the outputs' types, not their size
+        if interpreted.choose(engine, kernels.cached(key, probe), spec) == "interpreted":
             if engine == "interpreted":
                 return interpreted.run_interpreted(spec)
             interpreted.build_in_background(spec)
@@ -287,6 +287,7 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
                 return interpreted.run_interpreted(spec)
             except interpreted.InterpretedFailure:
                 pass  # auto: compile here instead
+    call_args, key, mech, wires, seg_actual, seg_reached = _prepared(spec, args)
     kernel = kernels(key, call_args)  # compiles outside the timing
     t0 = time.perf_counter()
     if progress is True or isinstance(progress, Display):
@@ -385,10 +386,9 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         The closed-loop controller (:mod:`smafinger.control.params`: ``pid``, ``fuzzy-pid``,
         ``sliding-mode``, ``rapid-heating``, ``resistance``); default the paper's PWM-PID.
     engine : {"auto", "compiled", "interpreted"}, optional
-        Default ``$SMAFINGER_ENGINE``, else ``auto``: the compiled kernel if numba has it cached;
-        if not, a short run interpreted (plain Python in a child process, the same equations;
-        about 1 s for the paper's 45 s cycle at the long step) while the kernel compiles in the
-        background for later runs (:mod:`.interpreted`).
+        Default ``$SMAFINGER_ENGINE``, else ``auto``: the compiled kernel if cached, else a
+        short run interpreted (the same equations in plain Python; 1.2 s for the 45 s cycle)
+        while the kernel compiles in the background (:mod:`.interpreted`).
 
     Returns
     -------
