@@ -34,6 +34,7 @@ from pathlib import Path
 
 from . import integrators
 from .defaults import ENGINE_ENV, ENGINES
+
 #: interpreted cost of a sub-step [s], and of each integrator stage in it (a conservative fit to
 #: the paper's full cycle, 45 s, on a 2-core machine: 1.2 s at the long step, 9,003 one-stage
 #: sub-steps, estimated 1.2 s; 14.2 s at rk4 1 ms, 83,282 four-stage sub-steps, estimated 24 s)
@@ -140,19 +141,24 @@ def _build_path(spec, suffix: str) -> Path:
     return Path(tempfile.gettempdir()) / f"smafinger-build-{user}-{hashlib.sha1(key.encode()).hexdigest()[:16]}{suffix}"
 
 
-def _build(spec) -> None:
-    from .run import compile_kernel
+def _locked(file) -> bool:
+    """Take the lock on an open file; False if another process holds it (no lock off POSIX)."""
     try:
         import fcntl
-    except ImportError:  # not POSIX: no lock
-        compile_kernel(spec)
-        return
+    except ImportError:
+        return True
+    try:
+        fcntl.flock(file, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        return False
+    return True
+
+
+def _build(spec) -> None:
+    from .run import compile_kernel
     with open(_build_path(spec, ".lock"), "w") as lock:
-        try:
-            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            return  # another process is compiling it
-        compile_kernel(spec)
+        if _locked(lock):  # else another process is compiling it
+            compile_kernel(spec)
 
 
 def _blow_up(spec, exc: ArithmeticError | ValueError):

@@ -91,7 +91,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
         if params.mechanism != "joint":
             return f"mechanism {params.mechanism} with the rate law: not validated at long steps"
         if opts.joule_heating != JouleHeating.PER_METRE:
-            return f"joule_heating {opts.joule_heating.label}: not validated at long steps (1.2 deg RMS on the full cycle)"
+            return (f"joule_heating {opts.joule_heating.label}: not validated at long steps (1.2 deg RMS on the "
+                    "full cycle)")
         if controller is not None and controller.label != "pid":
             return f"controller {controller.label}: validated for the paper's PWM-PID only"
     if params.pwm_period_s > LONG_STEP_DT_S:
