@@ -7,7 +7,7 @@ import pytest
 
 from smafinger import SimulationError, simulate
 from smafinger.engine import integrators
-from smafinger.engine.kernel import run_kernel
+from smafinger.engine.kernel import memory_stacks, run_kernel
 from smafinger.engine.run import kernel_args, make_spec
 from smafinger.engine.signals import kernel_views, new_outputs
 from smafinger.model.build import build_model
@@ -91,7 +91,7 @@ def test_interlock_counter_counts_a_forced_violation(numerics):
     run = args["run"]
     mech, wires = kernel_views(*new_outputs(run.t_end_ticks // run.out_ticks + 1, 2))
     counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
-                                np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+                                np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), memory_stacks(2))
     assert counters.violations == counters.substeps == round(0.1 / spec.dt_s)  # every sub-step counted
 
 

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from smafinger import simulate
-from smafinger.engine.kernel import run_kernel
+from smafinger.engine.kernel import memory_stacks, run_kernel
 from smafinger.engine.pwm import PwmModel, averaged_drive, sampled_phases
 from smafinger.engine.run import kernel_args, make_spec
 from smafinger.engine.signals import kernel_views, new_outputs
@@ -61,7 +61,7 @@ def _forced_violation(pwm):
     run = args["run"]
     mech, wires = kernel_views(*new_outputs(run.t_end_ticks // run.out_ticks + 1, 2))
     counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
-                                np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64))
+                                np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), memory_stacks(2))
     return counters
 
 

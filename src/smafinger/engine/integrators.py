@@ -91,19 +91,15 @@ def axpy(y, c, k):
 
 
 @njit(cache=True, forceinline=True)
-def phi1(z):
-    """(e^z - 1) / z, 1 at z = 0 (exponential integrators)."""
+def phi12(z):
+    """(phi1(z), phi2(z)) = ((e^z - 1) / z, (e^z - 1 - z) / z^2), (1, 1/2) at z = 0, from one expm1
+    (exponential integrators); near 0 by their Taylor series."""
     if abs(z) < 1e-5:
-        return 1.0 + 0.5 * z
-    return math.expm1(z) / z
-
-
-@njit(cache=True, forceinline=True)
-def phi2(z):
-    """(e^z - 1 - z) / z^2, 1/2 at z = 0."""
+        return 1.0 + 0.5 * z, 0.5 + z / 6.0 + z * z / 24.0
+    e = math.expm1(z)
     if abs(z) < 1e-3:
-        return 0.5 + z / 6.0 + z * z / 24.0
-    return (math.expm1(z) - z) / (z * z)
+        return e / z, 0.5 + z / 6.0 + z * z / 24.0
+    return e / z, (e - z) / (z * z)
 
 
 @njit(cache=True, forceinline=True)
@@ -138,8 +134,8 @@ def _damped_mechanism(method, y, k1, h, c, kappa):
         else:
             dv = h * k1.v / (1.0 + c * h)
         return y.q + h * (k1.q + dv), y.v + dv
-    z = -c * h
-    return y.q + h * k1.q + h * h * phi2(z) * k1.v, y.v + h * phi1(z) * k1.v
+    p1, p2 = phi12(-c * h)
+    return y.q + h * k1.q + h * h * p2 * k1.v, y.v + h * p1 * k1.v
 
 
 @njit(cache=True, forceinline=True)

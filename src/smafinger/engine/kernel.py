@@ -34,6 +34,7 @@ from .integrators import Method
 from .substep import (STACK_CAPACITY, Counters, authors_calls_inputs, decide, initial_commands, initial_inputs,
                       initial_state, integrate)
 from .tuples import filled, with_field
+from .unmanaged import unmanaged
 
 
 class RunSettings(NamedTuple):
@@ -60,6 +61,11 @@ class Program(NamedTuple):
     ticks: object  #: int64[n]
     level: object  #: float64[n, n_wires]
     duty: object  #: float64[n, n_wires]
+
+
+def memory_stacks(n_wires: int) -> np.ndarray:
+    """The kernel's scratch for each wire's reversal-point stack (return-point memory), zeros."""
+    return np.zeros((n_wires, STACK_CAPACITY, STACK_COLUMNS))
 
 
 @njit(cache=True, forceinline=True)
@@ -179,15 +185,16 @@ def _step_event(s, run, t, next_event, locate):
 
 
 @njit(cache=True, nogil=True)
-def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reached):
+def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reached, memory_scratch):
     """Simulate from t = 0 to t_end; fill the output arrays (one row per output sample).
 
     ``mech_out`` (samples x mechanism fields) and ``wire_out`` (samples x wires x wire fields) are
     written by column (``signals.MC``, ``signals.WC``). ``seg_reached[k]`` becomes the tick at
     which segment k's target was entered for good (within ``run.tol`` for ``run.hold_ticks``), -1 if
     never. Returns (counters, state, t_fail_s): if the state became NaN or Inf, ``counters.status``
-    is 1 and ``state`` is the state at ``t_fail_s``. No array is passed to a helper on the
-    per-sub-step path (each pass costs atomic reference counting).
+    is 1 and ``state`` is the state at ``t_fail_s``. ``memory_scratch`` (:func:`memory_stacks`)
+    holds the wires' reversal points. The arrays the per-sub-step path passes on (the stacks, the
+    outputs) go as views without reference counting (:mod:`.unmanaged`): the caller keeps them.
     """
     y, inputs, cmds = _initial_run(model, run)
     ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
@@ -195,7 +202,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     geom, geom_q = geometry(model, y.q), y.q
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
-    stacks = np.zeros((len(model.wires), STACK_CAPACITY, STACK_COLUMNS))  # reversal points, per wire
+    stacks = unmanaged(memory_scratch)  # reversal points, per wire
+    mo, wo = unmanaged(mech_out), unmanaged(wire_out)
     n_out = mech_out.shape[0]
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1, geom)
     integrating = 1.0
@@ -243,7 +251,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             now = (int(a), y, aux, cmds, drives, stuck, s.q_target, s.next_seg - 1, geom)
             final = t >= run.t_end_ticks
             if out_i < n_out and (next_out < a or (final and next_out == a)):
-                out_i, next_out = _flush(mech_out, wire_out, out_i, next_out, run, model.wires, a, final, prev, now)
+                out_i, next_out = _flush(mo, wo, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
             y, counters, t_fail, inputs = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
                                             phase_mid, phase_end, memory.error)

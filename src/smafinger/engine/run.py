@@ -20,7 +20,7 @@ from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
 from . import integrators, interpreted, numerics, pwm as pwm_models
 from .compiled import INTERPRETED, kernels
-from .kernel import Program, RunSettings
+from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
@@ -240,7 +240,8 @@ def kernel_args(spec: RunSpec) -> dict:
 
 def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
     mo, wo = kernel_views(mech, wires)
-    return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached)
+    return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached,
+            memory_stacks(wires.shape[1]))
 
 
 def _prepared(spec: RunSpec, args: dict | None = None, samples: int | None = None) -> tuple:
