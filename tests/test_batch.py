@@ -88,7 +88,7 @@ def test_specs_product_and_chunking():
     assert [(s.params.name, s.profile.segments[0].target_deg) for s in specs] == [
         ("paper2010", -25.0), ("paper2010", -55.0), ("authors2020", -25.0), ("authors2020", -55.0)]
     assert [len(c) for c in batch.chunked(list(range(10)), 4)] == [4, 4, 2]
-    assert batch.auto_chunk_size(231, 2) == 8
+    assert batch.auto_chunk_size(231, 2) == 29
     assert batch.auto_chunk_size(3, 2) == 1
     assert batch.auto_chunk_size(100000, 2) == 64
 

@@ -86,12 +86,15 @@ def chunked(tasks: Iterable, size: int) -> Iterator[list]:
         yield chunk
 
 
-def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 16, lo: int = 1, hi: int = 64) -> int:
+def auto_chunk_size(n_tasks: int, slots: int, per_slot: int = 4, lo: int = 1, hi: int = 64) -> int:
     """Runs per task: about ``per_slot`` tasks per worker slot, within [lo, hi].
 
-    Many small tasks balance the end of a batch: with a run at about 7 ms, 16 tasks per
-    slot keep a task near 50 ms (scheduling costs well under 1 ms locally and a few ms on
-    Dask) while the last task leaves a worker idle for only that long.
+    A task's hand-over costs about 1.5 ms when both cores are busy (the result pickled, the
+    next task sent), as much as a few long-step runs: on 2 cores the Fig. 8 sweep (231 runs)
+    ran 1.52-1.67x faster in parallel with 8 runs per task (16 tasks per slot), 1.90-1.98x
+    with 29 (4 per slot), against 1.89x for the two processes' compute alone. Four tasks per
+    slot still leave room to balance the end of a batch: the last task idles a worker for a
+    quarter of its share at most.
     """
     if n_tasks <= 0:
         return 1
@@ -217,7 +220,7 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
         only what it returns travels back (must be picklable: a module-level function, a
         ``functools.partial`` of one, or :class:`Compact`). Default: the whole result.
     chunk_size : int, optional
-        Runs per task (default: about 16 tasks per worker, at most 64 runs).
+        Runs per task (default: about 4 tasks per worker, at most 64 runs).
     errors : {"raise", "return"}
         A failed run raises :class:`BatchError` (after the others finished), or its
         exception is returned in its place.
