@@ -30,7 +30,7 @@ def _bits(result):
     for w in dstate.wires:
         values += list(w)
     for a in aux.wires:
-        values += list(a)
+        values += list(a[:-1]) + list(a.rates_per_v)  # the last field is a WireState
     return np.array(values, dtype=np.float64).tobytes()
 
 

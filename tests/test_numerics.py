@@ -109,6 +109,13 @@ def test_the_algebraic_laws_long_step_on_the_authors_joint():
                                                                                np.max(np.abs(err)))
 
 
+def test_the_algebraic_law_keeps_the_reference_under_a_fast_switched_program():
+    """With the algebraic law a program's steps must be 0.5 s apart (numerics.PROGRAM_MIN_STEP_S)."""
+    for on_s, off_s, want in ((0.08, 0.02, REF), (4.0, 1.0, STIFF)):
+        program = dict(voltage=_square(on_s, off_s, "0.6", t_s=10.0), drive="duty")
+        assert _numerics(make_spec("linear-bias-spring", "open-loop", t_end_s=12.0, **program)) == want
+
+
 def test_whole_wire_heating_keeps_the_reference():
     """Not validated at long steps: paper2010-table2 with whole-wire heating, full cycle, 1.2 deg RMS."""
     p = get("paper2010-table2").replace(joule_heating="whole-wire")
@@ -127,16 +134,24 @@ def test_the_command_line_reports_the_numerics_it_used(tmp_path):
         assert (run["method"], run["dt_s"], run["pwm"]) == want
 
 
-def test_a_fast_switched_program_keeps_the_reference():
-    """An open-loop program switched faster than the long step holds (an emulated PWM) gets rk4:
-    the first-order wire update drifts with every switch (docs/speed.md)."""
-    square = ",".join(f"{k * 0.01:.2f}:8:0,{k * 0.01 + 0.008:.3f}:0:0" for k in range(800)) + ",8:0:0"
-    assert _numerics(make_spec("paper2010", "open-loop", voltage=square, t_end_s=12.0)) == REF
-    slow = "0:8:0,6:0:0"  # the Sec. 3.1 shape: validated
-    assert _numerics(make_spec("paper2010", "open-loop", voltage=slow, t_end_s=12.0)) == LONG
+def _square(on_s: float, off_s: float, on: str, t_s: float = 8.0) -> str:
+    """An open-loop program: drive ``on`` ("8:0", say) for on_s, nothing for off_s, for t_s seconds."""
+    off = ":".join("0" for _ in on.split(":"))
+    per = on_s + off_s
+    steps = ",".join(f"{k * per:.4f}:{on},{k * per + on_s:.4f}:{off}" for k in range(round(t_s / per)))
+    return f"{steps},{t_s:g}:{off}"
+
+
+@pytest.mark.parametrize("on_s, off_s", [(0.4, 0.1), (0.008, 0.002)])
+def test_a_fast_switched_program_holds_the_long_step(on_s, off_s):
+    """An emulated PWM (an 80 % square wave, down to a 10 ms period) gets the long step and holds
+    the budget: steps end at its switches, and the wires move at the mechanism's mean rate over a
+    step (integrators._wires_at_mean_rate; at the start's rate it drifted to 3.5 deg RMS at 8/2 ms)."""
+    square = _square(on_s, off_s, "8:0")
+    assert _numerics(make_spec("paper2010", "open-loop", voltage=square, t_end_s=12.0)) == LONG
     ref = simulate("paper2010", "open-loop", voltage=square, t_end_s=12.0, dt_s=1e-4)
     got = simulate("paper2010", "open-loop", voltage=square, t_end_s=12.0)
-    long = simulate("paper2010", "open-loop", voltage=square, t_end_s=12.0, method="exponential", dt_s=5e-3,
-                    pwm="averaged")
-    err = {k: np.abs(r.theta_deg - ref.theta_deg).max() for k, r in (("default", got), ("long", long))}
-    assert err["default"] < 0.05 and err["long"] > 1.0  # why: the long step drifts here (measured 4 deg)
+    err = got.theta_deg - ref.theta_deg
+    assert np.ptp(ref.theta_deg) > 10.0
+    assert np.sqrt(np.mean(err ** 2)) < 0.05 and np.max(np.abs(err)) < 0.3, (np.sqrt(np.mean(err ** 2)),
+                                                                               np.max(np.abs(err)))

@@ -15,7 +15,8 @@ from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
 #: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
 NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step, {LONG_STEP_DT_S:g} s, "
-                 f"{LONG_STEP_PWM}, where validated (the memory rule; in open loop a program with steps 0.5 s apart or more): "
+                 f"{LONG_STEP_PWM}, where validated (the memory rule; with the algebraic law "
+                 f"a program with steps 0.5 s apart or more): "
                  f"{LONG_STEP_METHOD} for the finger joint (its rate law with per-metre heating and the paper's PID "
                  f"or open loop; the algebraic law in open loop), {LONG_STEP_STIFF_METHOD} for the linear rig in "
                  f"open loop; a PWM period of 5 ms or less; "

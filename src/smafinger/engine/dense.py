@@ -12,13 +12,14 @@ at first order.
 from numba import njit
 
 from ..model.records import Aux, State, WireAux, WireState
+from .rhs import ZERO_WIRE_AUX
 from .tuples import filled, set_item
 
 
 @njit(cache=True, forceinline=True)
 def zero_aux(wires):
     """An :class:`~smafinger.model.records.Aux` of zeros for ``wires`` (a typed placeholder)."""
-    return Aux(0.0, filled(wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)))
+    return Aux(0.0, filled(wires, ZERO_WIRE_AUX))
 
 
 @njit(cache=True, forceinline=True)
@@ -36,7 +37,8 @@ def _wire_state(a, b, w):
 @njit(cache=True)
 def _wire_aux(a, b, w):
     return WireAux(_mix(a.xi, b.xi, w), _mix(a.sigma_Pa, b.sigma_Pa, w), _mix(a.force_N, b.force_N, w),
-                   _mix(a.spring_m, b.spring_m, w), _mix(a.arm_m, b.arm_m, w), _mix(a.dT_C_s, b.dT_C_s, w))
+                   _mix(a.spring_m, b.spring_m, w), _mix(a.arm_m, b.arm_m, w), _mix(a.dT_C_s, b.dT_C_s, w),
+                   a.rates_per_v)
 
 
 @njit(cache=True, forceinline=True)

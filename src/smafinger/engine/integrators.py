@@ -18,6 +18,13 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
 - ``exponential``: exponential Euler for the mechanism: (q, v) advanced exactly under the held
   load with the damping C_DF (phi functions), the wires by Euler. Like ``semi-implicit`` but
   exact for the damped motion under a constant load.
+- With both, the wires are advanced at the mechanism's mean rate over the step, dq / h, not at
+  its rate v at the start: a wire's rates are affine in the strain rate (Eq. 6), and the wire
+  update takes (dq - h v) times their growth per unit of v
+  (:func:`smafinger.model.wire.wire_rates`). Across a long step v changes by much (the damped
+  mechanism settles in 1/c = 0.5-1.6 ms), and the wires' strain then followed the start's v:
+  the full co-operative cycle at 10 ms steps had 0.047 deg RMS and 0.37 deg max error that way,
+  0.017 and 0.13 with the mean rate.
 - ``authors-ode4``: the authors' Simulink solver (ode4, classical RK4 at a fixed 1 ms step,
   MODEL-NOTES) with the PWM read at its stage times (:mod:`.pwm`, ``sampled``), the controller
   re-evaluated at every stage and its error rate from their Derivative block (:mod:`.authors`),
@@ -139,8 +146,21 @@ def _damped_mechanism(method, y, k1, h, c, kappa):
 
 
 @njit(cache=True, forceinline=True)
-def step(method, model, y, h, inputs, k1, geom, stages):
+def _wires_at_mean_rate(wires, aux, extra):
+    """The wires after an explicit update taken at the mechanism's start rate v, corrected to its
+    mean rate: ``extra`` = dq - h v, the mechanism's displacement beyond h v, times each wire's
+    rates' growth per unit of v (``aux.wires[i].rates_per_v``)."""
+    ws = wires
+    for i in range(len(ws)):
+        ws = set_item(ws, i, _wire_axpy(wires[i], extra, aux.wires[i].rates_per_v))
+    return ws
+
+
+@njit(cache=True, forceinline=True)
+def step(method, model, y, h, inputs, k1, aux, geom, stages):
     """y advanced by h (see the module docstring for the methods). Returns (y, evaluations, inputs).
+
+    ``aux``: the algebraic quantities at y, with k1 (the wires' rates' growth with v).
 
     RK4 as a loop over its three later stages (one right-hand-side call site, so that it is
     compiled once): the weighted sum accumulates k1 + 2 k2 + 2 k3 + k4 in that order.
@@ -156,7 +176,8 @@ def step(method, model, y, h, inputs, k1, geom, stages):
         ye = axpy(y, h, k1)
         kappa = load_stiffness(model, y, inputs, k1) if method == Method.SEMI_IMPLICIT else 0.0
         q, v = _damped_mechanism(method, y, k1, h, inputs.viscous / model.dynamics.inertia, kappa)
-        return State(q, v, ye.error_integral, ye.wires), 0, inputs
+        wires = _wires_at_mean_rate(ye.wires, aux, (q - y.q) - h * k1.q)
+        return State(q, v, ye.error_integral, wires), 0, inputs
     half = 0.5 * h
     acc = k1
     k = k1

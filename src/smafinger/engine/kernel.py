@@ -253,8 +253,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             if out_i < n_out and (next_out < a or (final and next_out == a)):
                 out_i, next_out = _flush(mo, wo, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
-            y, counters, t_fail, inputs = integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s,
-                                            phase_mid, phase_end, memory.error)
+            y, counters, t_fail, inputs = integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters, cmds,
+                                                    s, phase_mid, phase_end, memory.error)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b

@@ -20,6 +20,10 @@ from ..model.wire import wire_rates
 from .tuples import filled, set_item
 
 
+#: a wire's algebraic quantities, all zero (a typed placeholder)
+ZERO_WIRE_AUX = WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+
+
 class Geometry(NamedTuple):
     """Everything that depends on q alone: reused while q does not change (a stuck mechanism)."""
 
@@ -54,10 +58,12 @@ def _wire_terms(model, state, inputs, geom, i):
     wi = inputs.wires[i]
     rt = geom.routes[i]
     opts = model.options
-    dT, dsigma, dTc, dxi, sigma, xi, x_s = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive, opts)
+    dT, dsigma, dTc, dxi, sigma, xi, x_s, per_v = wire_rates(wire, ws, wi, rt, state.v, inputs.current_drive,
+                                                              opts)
     heat = joule_power_per_m(wire, wi.drive, inputs.current_drive, opts.joule_heating) * wire.wire_length_m
     rate = WireState(dT, dsigma, electrical_power(wire, wi.drive, inputs.current_drive), heat, dTc, dxi)
-    aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt.arm_m, dT)
+    aux = WireAux(xi, sigma, sigma * wire.area_m2, x_s, rt.arm_m, dT,
+                  WireState(per_v[0], per_v[1], 0.0, 0.0, 0.0, per_v[2]))
     return rate, aux, wire_load(sigma, wire.area_m2, rt.dpath_dq)
 
 
@@ -65,7 +71,7 @@ def _wire_terms(model, state, inputs, geom, i):
 def derivative(state, inputs, model, geom):
     """(dstate/dt, aux): the derivative of the state and the algebraic quantities (loads, xi, sigma)."""
     rates = filled(state.wires, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-    auxs = filled(state.wires, WireAux(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    auxs = filled(state.wires, ZERO_WIRE_AUX)
     load = 0.0
     for i in range(len(state.wires)):  # one copy of the wire physics, whatever the wire count
         r, a, l_i = _wire_terms(model, state, inputs, geom, i)

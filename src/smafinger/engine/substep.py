@@ -267,8 +267,10 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 
 @njit(cache=True, forceinline=True)
-def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, phase_mid, phase_end, error_major):
-    """Advance the state over [a, b] (ticks) and apply the post-step constraints.
+def integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters, cmds, s, phase_mid, phase_end,
+              error_major):
+    """Advance the state over [a, b] (ticks) and apply the post-step constraints (``k1``, ``aux``:
+    the derivative and the algebraic quantities at the start).
 
     With the authors' solver the later stages read the controller and the PWM at their own
     states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
@@ -278,7 +280,7 @@ def integrate(model, run, y, inputs, geom, k1, a, b, stuck, counters, cmds, s, p
     """
     if b > a:
         stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end, error_major)
-        y, n, inputs = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, geom, stages)
+        y, n, inputs = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, aux, geom, stages)
         y = _xi_caught_up(model, y, inputs)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)

@@ -96,8 +96,19 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
 
 
 @njit(cache=True, forceinline=True)
+def _strain_driven(wire, dT0, D_eq, deps, xT, xs, sigma):
+    """(dT/dt, dsigma/dt, dxi/dt) of the rate law at strain rate ``deps`` (Eqs. 7b, 11 with the
+    latent heat): T' and sigma' solved together, dxi/dt = xi_T T' + xi_sigma sigma'."""
+    den = 1.0 + D_eq * wire.eps_R * xs
+    dT = latent_heat_rate(dT0, D_eq * deps / den, D_eq * wire.eps_R * xT / den, xT, xs, wire)
+    dsigma = stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma)
+    return dT, dsigma, xT * dT + xs * dsigma
+
+
+@njit(cache=True, forceinline=True)
 def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
-    """A wire's (dT/dt, dsigma/dt, dT_case/dt, dxi/dt) and (sigma, xi, spring elongation).
+    """A wire's (dT/dt, dsigma/dt, dT_case/dt, dxi/dt), (sigma, xi, spring elongation) and the
+    rates' growth per unit of the mechanism's rate v.
 
     ``route_now``: the wire's :class:`~smafinger.model.kinematics.WireGeometry` at the current q;
     ``wi`` the wire's held inputs.
@@ -105,6 +116,12 @@ def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
     the state's ``xi_integrated``); with the latent heat on, T' and sigma' are solved together.
     Algebraic law: sigma solved with xi; the latent heat then takes dxi/dt = xi_T T' (sigma's own
     rate is not part of the state); the returned dxi/dt is 0 (no stress to catch up).
+
+    The rates of T, sigma and xi_integrated are affine in v (Eq. 6) while the wire is taut: their
+    growth per unit of v, (d/dv of dT/dt, dsigma/dt, dxi/dt), is the last value returned, for an
+    integrator that moves the mechanism at another rate than v over a step
+    (:func:`smafinger.engine.integrators.step`). Zeros when the tendon is slack (sigma <= 0: the
+    stress rate is floored there, not affine) and with the algebraic law (no stress rate).
     """
     path, dpath = route_now.path_m, route_now.dpath_dq
     T = ws.T_C
@@ -114,15 +131,17 @@ def wire_rates(wire, ws, wi, route_now, v, current_drive, opts):
         sigma, xi, x_s = algebraic_stress(wire, total_strain(wire, path), T, wi.branch)
         if wire.latent_heat_J_kg != 0.0:
             dT0 = latent_heat_rate(dT0, 0.0, 0.0, xi_on_branch(wi.branch, T, sigma, wire)[1], 0.0, wire)
-        return dT0, 0.0, dTc, 0.0, sigma, xi, x_s
+        return dT0, 0.0, dTc, 0.0, sigma, xi, x_s, (0.0, 0.0, 0.0)
     sigma = ws.sigma_Pa
     xi, xT, xs = xi_on_branch(wi.branch, T, sigma, wire)
     D_eq, x_s = rate_law_modulus(wire, sigma, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))
     deps = dpath * v / wire.wire_length_m  # Eq. (6): Delta eps = Delta path / L_w
-    den = 1.0 + D_eq * wire.eps_R * xs
-    dT = latent_heat_rate(dT0, D_eq * deps / den, D_eq * wire.eps_R * xT / den, xT, xs, wire)
-    dsigma = stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma)
-    return dT, dsigma, dTc, xT * dT + xs * dsigma, sigma, xi, x_s
+    dT, dsigma, dxi = _strain_driven(wire, dT0, D_eq, deps, xT, xs, sigma)
+    per_v = (0.0, 0.0, 0.0)
+    if sigma > 0.0:  # the rates one unit of v further on, less these: exact while they are affine
+        dT1, dsigma1, dxi1 = _strain_driven(wire, dT0, D_eq, dpath * (v + 1.0) / wire.wire_length_m, xT, xs, sigma)
+        per_v = (dT1 - dT, dsigma1 - dsigma, dxi1 - dxi)
+    return dT, dsigma, dTc, dxi, sigma, xi, x_s, per_v
 
 
 @njit(cache=True, forceinline=True)
