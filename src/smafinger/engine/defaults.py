@@ -18,7 +18,7 @@ DEFAULT_PWM = "exact"
 
 # The long-step numerics: what a run that sets none of dt_s, method, pwm gets where they were
 # validated (engine.numerics.long_step_refusal): the full co-operative cycle 14x faster than the
-# reference, 0.013 deg RMS from a 1 us run (benchmarks/bench_speed.py, docs/speed.md).
+# reference, 0.0056 deg RMS from a 1 us run (benchmarks/bench_speed.py, docs/speed.md).
 LONG_STEP_DT_S = 5e-3
 LONG_STEP_METHOD = "exponential"
 LONG_STEP_PWM = "averaged"

@@ -64,8 +64,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
 
     Validated (benchmarks/bench_speed.py, tests/test_numerics.py) for:
 
-    - the rate-form stress law: the finger joint (every paper2010 scenario within 0.08 deg RMS
-      of a 0.1 ms RK4 run, the full cycle 0.013 deg), per-metre Joule heating (``whole-wire``
+    - the rate-form stress law: the finger joint (every paper2010 scenario within 0.066 deg RMS
+      of a 0.1 ms RK4 run, the full cycle 0.0047 deg), per-metre Joule heating (``whole-wire``
       heating of ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step), the
       paper's PWM-PID (``controller`` None or ``pid``, a prepared
       :class:`~smafinger.control.params.ControllerParameters`; its gains are not checked) or
