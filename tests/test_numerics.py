@@ -109,6 +109,14 @@ def test_the_algebraic_laws_long_step_on_the_authors_joint():
                                                                                np.max(np.abs(err)))
 
 
+def _square(on_s: float, off_s: float, on: str, t_s: float = 8.0) -> str:
+    """An open-loop program: drive ``on`` ("8:0", say) for on_s, nothing for off_s, for t_s seconds."""
+    off = ":".join("0" for _ in on.split(":"))
+    per = on_s + off_s
+    steps = ",".join(f"{k * per:.4f}:{on},{k * per + on_s:.4f}:{off}" for k in range(round(t_s / per)))
+    return f"{steps},{t_s:g}:{off}"
+
+
 def test_the_algebraic_law_keeps_the_reference_under_a_fast_switched_program():
     """With the algebraic law a program's steps must be 0.5 s apart (numerics.PROGRAM_MIN_STEP_S)."""
     for on_s, off_s, want in ((0.08, 0.02, REF), (4.0, 1.0, STIFF)):
@@ -132,14 +140,6 @@ def test_the_command_line_reports_the_numerics_it_used(tmp_path):
         assert rc == 0
         run = json.loads(out.read_text())["provenance"]["run"]
         assert (run["method"], run["dt_s"], run["pwm"]) == want
-
-
-def _square(on_s: float, off_s: float, on: str, t_s: float = 8.0) -> str:
-    """An open-loop program: drive ``on`` ("8:0", say) for on_s, nothing for off_s, for t_s seconds."""
-    off = ":".join("0" for _ in on.split(":"))
-    per = on_s + off_s
-    steps = ",".join(f"{k * per:.4f}:{on},{k * per + on_s:.4f}:{off}" for k in range(round(t_s / per)))
-    return f"{steps},{t_s:g}:{off}"
 
 
 @pytest.mark.parametrize("on_s, off_s", [(0.4, 0.1), (0.008, 0.002)])

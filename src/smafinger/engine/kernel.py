@@ -192,9 +192,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     written by column (``signals.MC``, ``signals.WC``). ``seg_reached[k]`` becomes the tick at
     which segment k's target was entered for good (within ``run.tol`` for ``run.hold_ticks``), -1 if
     never. Returns (counters, state, t_fail_s): if the state became NaN or Inf, ``counters.status``
-    is 1 and ``state`` is the state at ``t_fail_s``. ``memory_scratch`` (:func:`memory_stacks`)
-    holds the wires' reversal points. The arrays the per-sub-step path passes on (the stacks, the
-    outputs) go as views without reference counting (:mod:`.unmanaged`): the caller keeps them.
+    is 1 and ``state`` is the state at ``t_fail_s``. ``memory_scratch``: the wires' reversal points
+    (:func:`memory_stacks`). It and the outputs go on as views without reference counts (:mod:`.unmanaged`).
     """
     y, inputs, cmds = _initial_run(model, run)
     ctl = initial_control_state(model.controller, model)  # the controller's own state (control.interface)
@@ -202,8 +201,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     geom, geom_q = geometry(model, y.q), y.q
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
-    stacks = unmanaged(memory_scratch)  # reversal points, per wire
-    mo, wo = unmanaged(mech_out), unmanaged(wire_out)
+    stacks, mo, wo = unmanaged(memory_scratch), unmanaged(mech_out), unmanaged(wire_out)  # the caller owns them
     n_out = mech_out.shape[0]
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1, geom)
     integrating = 1.0

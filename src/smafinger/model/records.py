@@ -153,9 +153,9 @@ class WireAux(NamedTuple):
     spring_m: float  #: series spring elongation
     arm_m: float  #: moment arm b (Eqs. 4b, 5b); 1 for a slider
     dT_C_s: float
-    #: a WireState: how the rates of T, sigma and xi_integrated grow per unit of the mechanism's
-    #: rate (d/dv; they are affine in v through Eq. 6); zeros where they do not (model.wire.wire_rates)
-    rates_per_v: tuple
+    #: how the rates of T, sigma and xi_integrated grow per unit of the mechanism's rate (d/dv;
+    #: they are affine in v through Eq. 6); zeros where they are not (model.wire.wire_rates)
+    rates_per_v: WireState
 
 
 class Aux(NamedTuple):
