@@ -7,9 +7,12 @@ setting alike) and printed as ratios:
   long-step default, what the paper's scenarios use, and the baseline of the ratios;
 - ``long``: the long-step setting (exponential integrator, 5 ms, PWM averaged over its
   period, reach events located inside steps) and a few neighbours;
+- ``edge``: the same integrator and step with the PWM resolved at its edges (a sub-step at
+  every edge and output sample);
 - ``(default)`` marks the setting a run of the case gets when it sets none of ``dt_s``,
-  ``method``, ``pwm`` (``engine.numerics``: the long step for ``paper2010``, the reference for
-  the linear rig and ``authors2020``);
+  ``method``, ``pwm`` (``engine.numerics``: the long step for ``paper2010``, the linear rig in
+  open loop and ``authors2020``'s mechanics with the memory rule; the edge step for
+  ``authors2020`` with its own rule; the reference for the linear rig in closed loop);
 - the error of each against a reference run (rk4, 1 us, exact PWM edges): RMS and max of the
   coordinate on the output grid, and the reach times.
 
@@ -70,7 +73,8 @@ CASES = (
 )
 TODAY = ("rk4", 1e-3, "exact")  # the reference numerics (engine.numerics.REFERENCE)
 FAST = ("exponential", 5e-3, "averaged")  # the long step (engine.numerics.LONG_STEP)
-SETTINGS = (TODAY, FAST, ("semi-implicit", 5e-3, "averaged"), ("exponential", 1e-2, "averaged"),
+EDGE = ("exponential", 5e-3, "exact")  # the edge step (engine.numerics.EDGE_STEP): the PWM resolved
+SETTINGS = (TODAY, FAST, EDGE, ("semi-implicit", 5e-3, "averaged"), ("exponential", 1e-2, "averaged"),
             ("rk4", 1e-3, "averaged"), ("rk4", 1e-4, "exact"))
 
 #: the legacy engine (commit ff21ad0), co-operative full cycle at rk4 / 1 ms, CPU time of run_spec,
@@ -128,7 +132,7 @@ def bench_case(label, params, strategy, profile, t_end, repeat, ref_dt) -> dict:
         r = results[s]
         rms, mx = _errors(r, ref)
         best, med = min(walls[s]), statistics.median(walls[s])
-        tag = ("reference" if s == TODAY else ("long     " if s == FAST else "         ")) + \
+        tag = {TODAY: "reference", FAST: "long     ", EDGE: "edge     "}.get(s, "         ") + \
             (" (default)" if s == default else "          ")
         print(f"   {tag} {s[0]:13s} {s[1] * 1e3:4g} ms {s[2]:8s}: kernel {best * 1e3:7.2f} ms (median {med * 1e3:7.2f}), "
               f"{r.substeps:6d} sub-steps, RATIO reference/this {base / best:5.1f}x; "

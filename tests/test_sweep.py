@@ -106,9 +106,9 @@ def test_each_row_records_the_numerics_its_run_used(tmp_path):
                        "vary": {"pwm_period_s": {"values": [0.001, 0.01]}}})
     run_sweep(spec, tmp_path / "p.parquet", workers=1)
     df = pd.read_parquet(tmp_path / "p.parquet").sort_values("point")
-    # a 10 ms PWM period is longer than the long step: that point keeps the reference
+    # a 10 ms PWM period is longer than the long step: that point gets the edge step (the PWM resolved)
     assert list(zip(df["run_method"], df["run_dt_s"], df["run_pwm"])) == [("exponential", 0.005, "averaged"),
-                                                                         ("rk4", 0.001, "exact")]
+                                                                         ("exponential", 0.005, "exact")]
 
 
 def test_random_and_lhs_sampling_seeded():

@@ -20,6 +20,9 @@ NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step
                  f"{LONG_STEP_METHOD} for the finger joint (its rate law with per-metre heating and the paper's PID "
                  f"or open loop; the algebraic law in open loop), {LONG_STEP_STIFF_METHOD} for the linear rig in "
                  f"open loop; a PWM period of 5 ms or less; "
+                 f"else for the finger joint with per-metre heating (any hysteresis rule, PWM period or stress law; "
+                 f"open loop, pid, sliding-mode or rapid-heating): {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
+                 f"{DEFAULT_PWM} (sub-steps at every PWM edge); "
                  f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
                  f"{DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
 

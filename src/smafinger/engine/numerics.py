@@ -1,18 +1,23 @@
 """A run's numerical settings (integrator, step, PWM model): the ones given, or the run's default.
 
-A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets a long-step setting where it was
-validated against a run at a far shorter step with exact PWM edges, and the reference settings
-(RK4, 1 ms, exact PWM) everywhere else:
+A run that sets none of ``dt_s``, ``method`` and ``pwm`` gets the fastest setting that was
+validated for it against a run at a far shorter step with exact PWM edges:
 
-- the finger joint: :data:`LONG_STEP`, exponential Euler, 5 ms, period-averaged PWM; with the
-  rate-form stress law in closed and in open loop, with the algebraic law (the authors' 2020
+- :data:`LONG_STEP`, exponential Euler, 5 ms, period-averaged PWM, on the finger joint: with
+  the rate-form stress law in closed and in open loop, with the algebraic law (the authors' 2020
   model) in open loop under a program whose steps are at least 0.5 s apart;
-- a slider pulled directly by the wire (the linear bias-spring rig, algebraic law):
-  :data:`LONG_STEP_STIFF`, semi-implicit Euler with the wire's stiffness implicit too
-  (:func:`.integrators.load_stiffness`), 5 ms, period-averaged PWM, in open loop only. A
-run that sets any of the three gets the reference values for the others, as before the
-long-step default existed. Where the long step holds and why it does not elsewhere:
-docs/speed.md.
+- :data:`LONG_STEP_STIFF` on a slider pulled directly by the wire (the linear bias-spring rig,
+  algebraic law): semi-implicit Euler with the wire's stiffness implicit too
+  (:func:`.integrators.load_stiffness`), 5 ms, period-averaged PWM, in open loop only;
+- :data:`EDGE_STEP` on the finger joint where only the average is the trouble (a hysteresis
+  rule that follows the PWM ripple, a PWM period longer than the step, the authors' 2020 model in
+  closed loop, the sliding-mode and rapid-heating controllers): exponential Euler with the PWM
+  resolved at its edges, so a sub-step ends at every edge and output sample, as with the
+  reference, but costs one right-hand side instead of four;
+- the reference settings (RK4, 1 ms, exact PWM) everywhere else.
+
+A run that sets any of the three gets the reference values for the others, as before the
+long-step default existed. Where each holds and why it does not elsewhere: docs/speed.md.
 """
 
 from __future__ import annotations
@@ -52,11 +57,23 @@ LONG_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
 #: On the joint the series tendon spring and the joint's damping leave exponential Euler
 #: better (authors2020's mechanics, open loop: 0.013 deg RMS against semi-implicit's 0.028)
 LONG_STEP_STIFF = Numerics(LONG_STEP_STIFF_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
+#: the joint's integrator and step with the PWM resolved at its edges (:func:`edge_step_refusal`)
+EDGE_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, DEFAULT_PWM)
+#: the closed-loop controllers the edge step was validated with (None: the paper's PID).
+#: fuzzy-pid: 0.106 deg RMS, 0.49 max on the co-operative full cycle (rk4 at 1 ms: 0.018, 0.083);
+#: resistance: its loop hunts, rk4 at 1 ms is 0.18 deg RMS, 1.1 max from rk4 at 0.1 ms itself
+EDGE_STEP_CONTROLLERS = ("pid", "sliding-mode", "rapid-heating")
 
 
 def long_step(params) -> Numerics:
     """The long-step setting of a parameter set's mechanism (module docstring)."""
     return LONG_STEP if params.mechanism == "joint" else LONG_STEP_STIFF
+
+
+def _shorter_than_the_step(t_end_s: float) -> str | None:
+    if not t_end_s >= LONG_STEP_DT_S:
+        return f"t_end_s = {t_end_s:g} is shorter than the long step ({LONG_STEP_DT_S:g} s)"
+    return None
 
 
 def long_step_refusal(params, controller, t_end_s: float, program=None) -> str | None:
@@ -84,8 +101,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
       algebraic law its steps must be :data:`PROGRAM_MIN_STEP_S` apart or more.
     """
     opts = params.options
-    if not t_end_s >= LONG_STEP_DT_S:
-        return f"t_end_s = {t_end_s:g} is shorter than the long step ({LONG_STEP_DT_S:g} s)"
+    if (short := _shorter_than_the_step(t_end_s)) is not None:
+        return short
     if opts.hysteresis != Hysteresis.MEMORY:
         return f"hysteresis {opts.hysteresis.label}: its branch follows the PWM ripple the average removes"
     if opts.stress_law == StressLaw.ALGEBRAIC:
@@ -110,11 +127,38 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
     return None
 
 
+def edge_step_refusal(params, controller, t_end_s: float) -> str | None:
+    """Why :data:`EDGE_STEP` is not this run's default when the long step is refused (None: it is).
+
+    Validated (benchmarks/bench_defaults.py, tests/test_numerics.py, docs/speed.md) against RK4
+    at 0.1 ms on the finger joint with per-metre Joule heating, under any hysteresis rule, stress
+    law, PWM period and program, in open loop and with the controllers of
+    :data:`EDGE_STEP_CONTROLLERS`: 19 runs within 0.016 deg RMS and 0.12 deg max (the authors'
+    2020 model with its own rule: 0.0074 and 0.066 on profiles 1 and 2, the full cycle
+    co-operative and independent, a program; paper2010 with their rule or the dead-band one, PWM
+    periods of 10 to 50 ms, sliding-mode and rapid-heating control), 1.5-3.1x faster than the
+    reference. Whole-wire heating is not: its closed loop does not converge (RK4 at 0.1 ms is
+    0.076 deg RMS, 0.74 max from 10 us on the full cycle).
+    """
+    if (short := _shorter_than_the_step(t_end_s)) is not None:
+        return short
+    if params.mechanism != "joint":
+        return f"mechanism {params.mechanism}: not validated with the PWM resolved at long steps"
+    if params.options.joule_heating != JouleHeating.PER_METRE:
+        return (f"joule_heating {params.options.joule_heating.label}: not validated (its full cycle does not converge "
+                "with the step, RK4 included)")
+    if controller is not None and controller.label not in EDGE_STEP_CONTROLLERS:
+        return f"controller {controller.label}: not validated with the PWM resolved at long steps"
+    return None
+
+
 def choose(params, controller, t_end_s: float, method: str | None, dt_s: float | None,
            pwm: str | None, program=None) -> Numerics:
     """The run's numerics: the given values, else the run's default (module docstring)."""
     if method is None and dt_s is None and pwm is None:
-        return long_step(params) if long_step_refusal(params, controller, t_end_s, program) is None else REFERENCE
+        if long_step_refusal(params, controller, t_end_s, program) is None:
+            return long_step(params)
+        return EDGE_STEP if edge_step_refusal(params, controller, t_end_s) is None else REFERENCE
     return Numerics(REFERENCE.method if method is None else method,
                     REFERENCE.dt_s if dt_s is None else dt_s,
                     REFERENCE.pwm if pwm is None else pwm)
