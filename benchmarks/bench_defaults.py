@@ -27,6 +27,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
 
+from smafinger.bench.presets import bench_controller  # noqa: E402
+from smafinger.control.params import SlidingModeParameters  # noqa: E402
 from smafinger.engine.run import make_spec, run_spec  # noqa: E402
 from smafinger.parameters import get  # noqa: E402
 
@@ -61,7 +63,15 @@ CASES = {
     "paper2010 PWM 50 ms": dict(params=_p(pwm_period_s=0.05), **COOP),
     "sliding-mode": dict(params="paper2010", controller="sliding-mode", **COOP),
     "sliding-mode, independent": dict(params="paper2010", controller="sliding-mode", **IND),
+    "sliding-mode, the bench's tuning": dict(params="paper2010", **COOP,
+                                             controller=bench_controller("sliding-mode-tuned", get("paper2010"))),
+    "sliding-mode, boundary layer 0.01 rad/s": dict(params="paper2010", controller=SlidingModeParameters(
+        phi_q_per_s=0.01), **COOP),
+    "authors2020 sliding-mode, boundary layer 0.01 rad/s": dict(params="authors2020", controller=SlidingModeParameters(
+        phi_q_per_s=0.01), **COOP),
     "rapid-heating": dict(params="paper2010", controller="rapid-heating", **COOP),
+    "rapid-heating, the bench's tuning": dict(params="paper2010", **COOP,
+                                              controller=bench_controller("rapid-heating-tuned", get("paper2010"))),
     "rapid-heating, independent": dict(params="paper2010", controller="rapid-heating", **IND),
     "fuzzy-pid": dict(params="paper2010", controller="fuzzy-pid", **COOP),
     "fuzzy-pid, independent": dict(params="paper2010", controller="fuzzy-pid", **IND),
