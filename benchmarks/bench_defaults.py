@@ -52,6 +52,8 @@ CASES = {
     "authors2020 full cycle, independent": dict(params="authors2020", **IND),
     "authors2020 program": dict(params="authors2020", **PROGRAM),
     "authors2020 rapid-heating": dict(params="authors2020", controller="rapid-heating", **COOP),
+    "authors2020 with the memory rule, full cycle": dict(params=get("authors2020").replace(hysteresis="memory"),
+                                                         **COOP),
     "paper2010 authors' rule": dict(params=_p(hysteresis="authors2020"), **COOP),
     "paper2010 authors' rule, independent": dict(params=_p(hysteresis="authors2020"), **IND),
     "paper2010 authors' rule, program": dict(params=_p(hysteresis="authors2020"), **PROGRAM),
