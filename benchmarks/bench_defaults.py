@@ -1,7 +1,8 @@
 """Where each default numerics setting holds (engine.numerics): a script printing errors and
 ratios, not a timed test.
 
-For runs the long step (exponential, 5 ms, averaged PWM) is refused for, it prints, side by side
+For runs beyond the paper's joint under its PID (other hysteresis rules, PWM periods,
+controllers, the authors' 2020 model), it prints, side by side
 in one process (interleaved, best of ``--repeat``), the reference (rk4, 1 ms, exact PWM), the
 edge step (exponential, 5 ms, exact PWM: a sub-step at every edge and output sample) and the
 long step, each with its error against rk4 at 0.1 ms with exact PWM edges (RMS and max of
@@ -67,8 +68,14 @@ CASES = {
     "sliding-mode, independent": dict(params="paper2010", controller="sliding-mode", **IND),
     "sliding-mode, the bench's tuning": dict(params="paper2010", **COOP,
                                              controller=bench_controller("sliding-mode-tuned", get("paper2010"))),
+    "sliding-mode, the bench's tuning, independent": dict(params="paper2010", **IND, controller=bench_controller(
+        "sliding-mode-tuned", get("paper2010"))),
     "sliding-mode, boundary layer 0.01 rad/s": dict(params="paper2010", controller=SlidingModeParameters(
         phi_q_per_s=0.01), **COOP),
+    "sliding-mode, K 50 %, independent": dict(params="paper2010", controller=SlidingModeParameters(K_pct=50.0), **IND),
+    "sliding-mode, paper2010-table2, scheduled": dict(params="paper2010-table2", controller="sliding-mode",
+                                                      strategy="cooperative", profile="0:-25,6:-55,12:-40,18:-30",
+                                                      t_end_s=24.0),
     "authors2020 sliding-mode, boundary layer 0.01 rad/s": dict(params="authors2020", controller=SlidingModeParameters(
         phi_q_per_s=0.01), **COOP),
     "rapid-heating": dict(params="paper2010", controller="rapid-heating", **COOP),

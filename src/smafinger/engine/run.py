@@ -374,8 +374,8 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         None of them given: a long step (5 ms, averaged) where validated
         (:func:`.numerics.long_step_refusal`, all with the memory rule; with the algebraic law
         in open loop, a program with steps 0.5 s apart or more): exponential on the
-        finger joint (its rate law with per-metre heating and the paper's PID or open loop; the
-        algebraic law in open loop), semi-implicit on the linear rig (open loop only); else, on the
+        finger joint (its rate law with per-metre heating and the paper's PID, sliding-mode or
+        open loop; the algebraic law in open loop), semi-implicit on the linear rig (open loop only); else, on the
         joint with per-metre heating in open loop or with the pid, sliding-mode or rapid-heating
         controller, exponential at 5 ms with the PWM exact (a sub-step at every edge,
         :func:`.numerics.edge_step_refusal`); else rk4, 1 ms, exact (docs/speed.md). Any of them
