@@ -141,8 +141,8 @@ def edge_step_refusal(params, controller, t_end_s: float) -> str | None:
     at 0.1 ms on the finger joint with per-metre Joule heating, under any hysteresis rule, stress
     law, PWM period and program, in open loop and with the controllers of
     :data:`EDGE_STEP_CONTROLLERS`: the 20 runs of the benchmark that get it are within 0.037 deg
-    RMS and 0.28 deg max (the reference: 0.035 and 0.31), 1.4-4.6x faster than the reference
-    on a loaded machine (median 2.8x): the authors' 2020 model with its own rule (profiles 1 and
+    RMS and 0.28 deg max (the reference: 0.035 and 0.31), 1.7-3.0x faster than the reference
+    (median 2.2x): the authors' 2020 model with its own rule (profiles 1 and
     2, the full cycle co-operative and independent, a program, rapid-heating and sliding-mode
     control; within 0.0094 and 0.087) and with the memory rule (the full cycle, the worst);
     paper2010 with their rule or the dead-band one, PWM periods of 10 to 50 ms, rapid-heating
