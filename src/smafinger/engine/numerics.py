@@ -68,7 +68,7 @@ LONG_STEP_CONTROLLERS = ("pid", "sliding-mode")
 #: the closed-loop controllers the edge step was validated with (None: the paper's PID).
 #: fuzzy-pid: 0.106 deg RMS, 0.49 max on the co-operative full cycle (rk4 at 1 ms: 0.018, 0.083);
 #: resistance: its loop hunts, rk4 at 1 ms is 0.18 deg RMS, 1.1 max from rk4 at 0.1 ms itself
-EDGE_STEP_CONTROLLERS = ("pid", "sliding-mode", "rapid-heating")
+EDGE_STEP_CONTROLLERS = LONG_STEP_CONTROLLERS + ("rapid-heating",)
 
 
 def long_step(params) -> Numerics:

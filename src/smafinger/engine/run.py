@@ -371,15 +371,9 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         solver, RK4 with the PWM read at its stages; :mod:`.integrators`); the PWM drive
         resolved at its edges (``"exact"``) or its period-averaged power (``"averaged"``,
         valid when the PWM period is far below the wire's thermal time constant; :mod:`.pwm`).
-        None of them given: a long step (5 ms, averaged) where validated
-        (:func:`.numerics.long_step_refusal`, all with the memory rule; with the algebraic law
-        in open loop, a program with steps 0.5 s apart or more): exponential on the
-        finger joint (its rate law with per-metre heating and the paper's PID, sliding-mode or
-        open loop; the algebraic law in open loop), semi-implicit on the linear rig (open loop only); else, on the
-        joint with per-metre heating in open loop or with the pid, sliding-mode or rapid-heating
-        controller, exponential at 5 ms with the PWM exact (a sub-step at every edge,
-        :func:`.numerics.edge_step_refusal`); else rk4, 1 ms, exact (docs/speed.md). Any of them
-        given: the others from rk4, 1 ms, exact.
+        None of them given: the fastest setting validated for the run (:mod:`.numerics`: a
+        long step of 5 ms with the PWM averaged, else the joint's edge step with it exact, else
+        rk4, 1 ms, exact; docs/speed.md). Any of them given: the others from rk4, 1 ms, exact.
     tol_deg, tol_m, hold_s : float
         A target counts as reached once within ``tol_deg`` (joint) or ``tol_m`` (linear
         actuator) for ``hold_s``.
