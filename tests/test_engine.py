@@ -7,9 +7,10 @@ import pytest
 
 from smafinger import SimulationError, simulate
 from smafinger.engine import integrators
+from smafinger.engine.compiled import kernels
 from smafinger.engine.kernel import memory_stacks, run_kernel
-from smafinger.engine.run import kernel_args, make_spec
-from smafinger.engine.signals import kernel_views, new_outputs
+from smafinger.engine.run import _prepared, kernel_args, make_spec
+from smafinger.engine.signals import new_outputs
 from smafinger.model.build import build_model
 from smafinger.model.kinetics import g_heating
 from smafinger.parameters import get
@@ -89,7 +90,7 @@ def test_interlock_counter_counts_a_forced_violation(numerics):
     prog = args["prog"]
     forced = prog._replace(level=np.array([[8.0, 8.0]]), duty=np.array([[100.0, 100.0]]))  # bypasses the check
     run = args["run"]
-    mech, wires = kernel_views(*new_outputs(run.t_end_ticks // run.out_ticks + 1, 2))
+    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, 2)
     counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
                                 np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), memory_stacks(2))
     assert counters.violations == counters.substeps == round(0.1 / spec.dt_s)  # every sub-step counted
@@ -108,6 +109,39 @@ def test_interlock_never_violated_in_closed_loop(strategy):
 def test_output_grid_independent_of_step(dt):
     r = simulate("paper2010", "cooperative", "0:-25", t_end_s=3, dt_s=dt, output_interval_s=1e-3)
     assert not np.isnan(r.to_pandas().to_numpy()).any() and len(r.t) == 3001
+
+
+@pytest.mark.parametrize("case", [
+    ("paper2010", "cooperative", {"profile": "0:-25,reach:-55"}, {}),  # the long step: samples interpolated
+    ("paper2010", "cooperative", {"profile": "0:-25,reach:-55"}, {"method": "rk4"}),  # the reference
+    ("authors2020", "cooperative", {"profile": "0:-25,reach:-55"}, {}),  # the edge step
+    ("linear-bias-spring", "open-loop", {"voltage": "0:3,2:0"}, {}),
+])
+def test_every_signal_of_every_sample_is_recorded(case):
+    """The outputs are allocated unset but for the time row (signals.new_outputs): filled with
+    NaN here, the kernel leaves none of them, in any row."""
+    params, strategy, drive, numerics = case
+    spec = make_spec(params, strategy, t_end_s=4.0, **drive, **numerics)
+    call_args, key, mech, wires = _prepared(spec)[:4]
+    mech.fill(np.nan)
+    wires.fill(np.nan)
+    counters = kernels(key, call_args)(*call_args)[0]
+    assert counters.status == 0 and mech.shape[1] == 4001
+    assert not np.isnan(mech).any() and not np.isnan(wires).any()
+
+
+def test_a_sample_left_unrecorded_is_an_error(monkeypatch):
+    """The run checks that the kernel recorded every sample (a NaN time) instead of returning garbage."""
+    from smafinger.engine import run as run_mod
+
+    real = run_mod.kernels
+
+    def skip_last(key, args):
+        kernel = real(key, args)
+        return lambda *a: (kernel(*a), a[4].__setitem__((0, -1), np.nan))[0]
+    monkeypatch.setattr(run_mod, "kernels", skip_last)
+    with pytest.raises(RuntimeError, match="1 of its 3001 output samples not recorded"):
+        simulate("paper2010", "cooperative", "0:-25", t_end_s=3, engine="compiled")
 
 
 def test_reached_metric_agrees_with_reach_trigger():

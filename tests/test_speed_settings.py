@@ -16,7 +16,7 @@ from smafinger import simulate
 from smafinger.engine.kernel import memory_stacks, run_kernel
 from smafinger.engine.pwm import PwmModel, averaged_drive, sampled_phases
 from smafinger.engine.run import kernel_args, make_spec
-from smafinger.engine.signals import kernel_views, new_outputs
+from smafinger.engine.signals import new_outputs
 from smafinger.model.build import build_model
 from smafinger.parameters import get
 
@@ -24,7 +24,7 @@ FAST = dict(method="exponential", dt_s=5e-3, pwm="averaged")
 
 
 def _same(a, b):
-    return a.mechanism.tobytes() == b.mechanism.tobytes() and a.wires.tobytes() == b.wires.tobytes()
+    return a.mechanism_signals.tobytes() == b.mechanism_signals.tobytes() and a.wire_signals.tobytes() == b.wire_signals.tobytes()
 
 
 def test_authors_ode4_is_rk4_when_no_wire_is_switched():
@@ -59,7 +59,7 @@ def _forced_violation(pwm):
     args = kernel_args(spec)
     forced = args["prog"]._replace(level=np.array([[8.0, 8.0]]), duty=np.array([[30.0, 20.0]]))  # bypasses the check
     run = args["run"]
-    mech, wires = kernel_views(*new_outputs(run.t_end_ticks // run.out_ticks + 1, 2))
+    mech, wires = new_outputs(run.t_end_ticks // run.out_ticks + 1, 2)
     counters, _, _ = run_kernel(args["model"], run, args["segs"], forced, mech, wires,
                                 np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64), memory_stacks(2))
     return counters

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .engine.signals import columns
+from .engine.signals import MC, WC, columns, structured
 from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older imports)
 from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
@@ -19,14 +19,16 @@ from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metri
 class SimulationResult:
     """A run's signals (sampled at the output interval), metrics and run statistics.
 
-    ``mechanism`` and ``wires`` are the recorded structured arrays (one row per sample; wires:
-    one column per wire); :meth:`signal` and the attributes named like the exported columns
+    ``mechanism_signals`` (fields x samples) and ``wire_signals`` (wires x fields x samples) are
+    the recorded float64 arrays, one contiguous row per signal (rows ``engine.signals.MC`` and
+    ``WC``, SI units); :meth:`signal` and the attributes named like the exported columns
     (``result.theta_deg``, ``result.T_upper_C``) give them in the exported units.
+    :attr:`mechanism` and :attr:`wires` give them as structured arrays, one row per sample.
     """
 
     spec: Any
-    mechanism: np.ndarray
-    wires: np.ndarray
+    mechanism_signals: np.ndarray
+    wire_signals: np.ndarray
     segment_start_s: np.ndarray
     segment_reached_s: np.ndarray
     substeps: int
@@ -47,19 +49,31 @@ class SimulationResult:
         return [c[0] for c in self.columns]
 
     @property
+    def mechanism(self) -> np.ndarray:
+        """The mechanism's recorded fields as a structured array, one row per sample (a copy)."""
+        return structured(self.mechanism_signals, self.wire_signals)[0]
+
+    @property
+    def wires(self) -> np.ndarray:
+        """The wires' recorded fields as a structured array, samples x wires (a copy)."""
+        return structured(self.mechanism_signals, self.wire_signals)[1]
+
+    @property
     def t(self) -> np.ndarray:
-        return self.mechanism["t"]
+        return self.mechanism_signals[MC.t]
 
     def signal(self, name: str) -> np.ndarray:
-        """An exported signal by its column name (e.g. ``theta_deg``, ``T_upper_C``)."""
+        """An exported signal by its column name (e.g. ``theta_deg``, ``T_upper_C``): a view of
+        the recorded row if it is exported as recorded, else a scaled copy."""
         for col, fld, where, scale in self.columns:
             if col == name:
-                raw = self.mechanism[fld] if where == "mechanism" else self.wires[fld][:, where]
+                raw = (self.mechanism_signals[getattr(MC, fld)] if where == "mechanism"
+                       else self.wire_signals[where, getattr(WC, fld)])
                 return raw if scale == 1.0 else raw * scale
         raise KeyError(f"no signal {name!r} (signals: {', '.join(self.column_names)})")
 
     def __getattr__(self, name: str):
-        if name.startswith("_") or name in ("spec", "mechanism", "wires"):
+        if name.startswith("_") or name in ("spec", "mechanism_signals", "wire_signals"):
             raise AttributeError(name)
         try:
             return self.signal(name)
@@ -69,8 +83,9 @@ class SimulationResult:
     def decimated(self, every: int) -> "SimulationResult":
         """The result thinned to every ``every``-th sample, its metrics kept at full resolution."""
         metrics = self.metrics
-        return dataclasses.replace(self, mechanism=np.ascontiguousarray(self.mechanism[::every]),
-                                   wires=np.ascontiguousarray(self.wires[::every]), _metrics=metrics)
+        return dataclasses.replace(self, mechanism_signals=np.ascontiguousarray(self.mechanism_signals[:, ::every]),
+                                   wire_signals=np.ascontiguousarray(self.wire_signals[..., ::every]),
+                                   _metrics=metrics)
 
     def to_pandas(self):
         import pandas as pd

@@ -118,7 +118,7 @@ def _flush(mo, wo, out_i, next_out, run, wires, a, final, prev, now):
     geometry (for the wire resistance); one at ``a`` takes ``now``'s. With the exact PWM every
     sample falls on a sub-step start. Returns (out_i, next_out).
     """
-    n_out = mo.shape[0]
+    n_out = mo.shape[1]
     while out_i < n_out and (next_out < a or (final and next_out == a)):
         src = now if next_out == a else prev
         y, aux = src[1], src[2]
@@ -188,8 +188,8 @@ def _step_event(s, run, t, next_event, locate):
 def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reached, memory_scratch):
     """Simulate from t = 0 to t_end; fill the output arrays (one row per output sample).
 
-    ``mech_out`` (samples x mechanism fields) and ``wire_out`` (samples x wires x wire fields) are
-    written by column (``signals.MC``, ``signals.WC``). ``seg_reached[k]`` becomes the tick at
+    ``mech_out`` (mechanism fields x samples) and ``wire_out`` (wires x wire fields x samples) are
+    written by row (``signals.MC``, ``signals.WC``). ``seg_reached[k]`` becomes the tick at
     which segment k's target was entered for good (within ``run.tol`` for ``run.hold_ticks``), -1 if
     never. Returns (counters, state, t_fail_s): if the state became NaN or Inf, ``counters.status``
     is 1 and ``state`` is the state at ``t_fail_s``. ``memory_scratch``: the wires' reversal points
@@ -202,7 +202,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     counters = Counters(0, 0, 0, 0, 0)
     bounds = np.empty(len(model.wires) + 1)
     stacks, mo, wo = unmanaged(memory_scratch), unmanaged(mech_out), unmanaged(wire_out)  # the caller owns them
-    n_out = mech_out.shape[0]
+    n_out = mech_out.shape[1]
     prev = (-1, y, zero_aux(model.wires), cmds, filled(model.wires, 0.0), False, s.q_target, -1, geom)
     integrating = 1.0
     pwm_ref = 0.0  #: the sampled PWM's period reference time [s] (pwm.sampled_phases)

@@ -24,7 +24,7 @@ from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
-from .signals import MECHANISM_FIELDS, WIRE_FIELDS, kernel_views, new_outputs
+from .signals import MC, MECHANISM_FIELDS, WIRE_FIELDS, new_outputs, unrecorded
 
 
 
@@ -239,8 +239,7 @@ def kernel_args(spec: RunSpec) -> dict:
 
 
 def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
-    mo, wo = kernel_views(mech, wires)
-    return (args["model"], args["run"], args["segs"], args["prog"], mo, wo, seg_actual, seg_reached,
+    return (args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached,
             memory_stacks(wires.shape[1]))
 
 
@@ -298,8 +297,12 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
     wall = time.perf_counter() - t0
     if counters.status != 0:
         raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
+    missing = unrecorded(mech)
+    if missing:
+        raise RuntimeError(f"internal error: the run ended with {missing} of its {mech.shape[1]} output samples "
+                           "not recorded")
     return SimulationResult(
-        spec=spec, mechanism=mech, wires=wires, segment_start_s=seg_actual * TICK_S,
+        spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=seg_actual * TICK_S,
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
         substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall,
         engine="interpreted" if INTERPRETED else "compiled")
@@ -333,7 +336,7 @@ def _run_with_progress(call, mech, t_end_s, progress):
         th.start()
         while th.is_alive():
             th.join(0.1)
-            done = mech["t"]
+            done = mech[MC.t]
             filled = done[~np.isnan(done)]
             task.update(completed=float(filled[-1]) if filled.size else 0.0)
     finally:
