@@ -130,6 +130,16 @@ def test_every_signal_of_every_sample_is_recorded(case):
     assert not np.isnan(mech).any() and not np.isnan(wires).any()
 
 
+def test_structured_arrays_hold_the_recorded_signals():
+    """result.mechanism / result.wires (one row per sample) are the recorded rows, transposed."""
+    r = simulate("paper2010", "cooperative", "0:-25", t_end_s=0.5)
+    m, w = r.mechanism, r.wires
+    assert m.shape == (501,) and w.shape == (501, 2)
+    assert np.array_equal(m["t"], r.t_s) and np.array_equal(m["q"] * r.spec.params.coordinate.scale, r.theta_deg)
+    assert np.array_equal(w["T"][:, 0], r.T_upper_C) and np.array_equal(w["sigma"][:, 1], r.sigma_lower_Pa)
+    assert np.array_equal(w["R"][:, 1], r.R_lower_ohm)
+
+
 def test_a_sample_left_unrecorded_is_an_error(monkeypatch):
     """The run checks that the kernel recorded every sample (a NaN time) instead of returning garbage."""
     from smafinger.engine import run as run_mod
