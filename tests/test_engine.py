@@ -130,6 +130,48 @@ def test_every_signal_of_every_sample_is_recorded(case):
     assert not np.isnan(mech).any() and not np.isnan(wires).any()
 
 
+def _same(a, b) -> bool:
+    """Equal, NaN equal to NaN (dicts and lists compared item by item)."""
+    if isinstance(a, dict):
+        return isinstance(b, dict) and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return isinstance(b, list) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b
+
+
+@pytest.mark.parametrize("case", [
+    ("paper2010", "cooperative", {"profile": "0:-25,reach:-55"}, {}),  # the long step: samples interpolated
+    ("paper2010", "independent", {"profile": "0:-25,reach:-55"}, {"method": "rk4"}),  # the reference
+    ("authors2020", "cooperative", {"profile": "0:-25,reach:-55"}, {}),  # the edge step
+    ("linear-bias-spring", "open-loop", {"voltage": "0:3,2:0"}, {}),
+    ("paper2010", "open-loop", {"voltage": "0:100:0"}, {}),  # absurd: plausibility warnings
+])
+def test_a_run_recording_only_its_metrics_signals_has_the_same_metrics(case):
+    """record="metrics" (a sweep's runs) writes signals.METRIC_FIELDS alone: the same metrics, warnings
+    and sweep row as recording every signal, the same values in the signals it has, and no other."""
+    from smafinger.analysis.sweep_rows import metrics_row
+    from smafinger.engine.run import run_spec
+
+    params, strategy, drive, numerics = case
+    spec = make_spec(params, strategy, t_end_s=4.0, **drive, **numerics)
+    full, lean = run_spec(spec), run_spec(spec, record="metrics")
+    assert _same({k: v for k, v in lean.summary().items() if k != "wall_s"},
+                 {k: v for k, v in full.summary().items() if k != "wall_s"})
+    assert _same({k: v for k, v in metrics_row(lean).items() if k != "wall_s"},
+                 {k: v for k, v in metrics_row(full).items() if k != "wall_s"})
+    if "100" in str(drive):
+        assert full.summary()["warnings"]
+    assert set(lean.column_names) < set(full.column_names)
+    for name in lean.column_names:
+        assert np.array_equal(lean.signal(name), full.signal(name))
+    missing = next(n for n in full.column_names if n not in lean.column_names)
+    with pytest.raises(KeyError, match="recorded only its metrics' signals"):
+        lean.signal(missing)
+    assert np.isnan(lean.wires["V"]).all() and np.array_equal(lean.wires["T"], full.wires["T"])
+
+
 def test_structured_arrays_hold_the_recorded_signals():
     """result.mechanism / result.wires (one row per sample) are the recorded rows, transposed."""
     r = simulate("paper2010", "cooperative", "0:-25", t_end_s=0.5)

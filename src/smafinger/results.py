@@ -35,14 +35,26 @@ class SimulationResult:
     interlock_violations: int
     wall_s: float
     engine: str = "compiled"  #: the kernel that ran: compiled, or interpreted (engine.interpreted)
+    #: the recorded fields if not every signal (``run_spec(record="metrics")``: a sweep's runs)
+    recorded: tuple[str, ...] | None = None
     _metrics: dict | None = field(default=None, repr=False)
 
     # ---- signals ---------------------------------------------------------------------
     @property
     def columns(self) -> list[tuple[str, str, str | int, float]]:
-        """Exported columns: (name, recorded field, "mechanism" or wire index, scale)."""
+        """Exported columns: (name, recorded field, "mechanism" or wire index, scale); those of the
+        recorded fields only if the run did not record every signal."""
         p = self.spec.params
-        return columns(p.mechanism, p.wire_names, p.coordinate.scale)
+        cols = columns(p.mechanism, p.wire_names, p.coordinate.scale)
+        return cols if self.recorded is None else [c for c in cols if c[1] in self.recorded]
+
+    def _structured(self) -> tuple[np.ndarray, np.ndarray]:
+        m, w = structured(self.mechanism_signals, self.wire_signals)
+        for arr in (m, w):
+            for name in arr.dtype.names if self.recorded is not None else ():
+                if name not in self.recorded:
+                    arr[name] = np.nan  # not recorded: its memory was never written
+        return m, w
 
     @property
     def column_names(self) -> list[str]:
@@ -51,12 +63,12 @@ class SimulationResult:
     @property
     def mechanism(self) -> np.ndarray:
         """The mechanism's recorded fields as a structured array, one row per sample (a copy)."""
-        return structured(self.mechanism_signals, self.wire_signals)[0]
+        return self._structured()[0]
 
     @property
     def wires(self) -> np.ndarray:
         """The wires' recorded fields as a structured array, samples x wires (a copy)."""
-        return structured(self.mechanism_signals, self.wire_signals)[1]
+        return self._structured()[1]
 
     @property
     def t(self) -> np.ndarray:
@@ -70,7 +82,8 @@ class SimulationResult:
                 raw = (self.mechanism_signals[getattr(MC, fld)] if where == "mechanism"
                        else self.wire_signals[where, getattr(WC, fld)])
                 return raw if scale == 1.0 else raw * scale
-        raise KeyError(f"no signal {name!r} (signals: {', '.join(self.column_names)})")
+        also = "; this run recorded only its metrics' signals" if self.recorded is not None else ""
+        raise KeyError(f"no signal {name!r} (signals: {', '.join(self.column_names)}{also})")
 
     def __getattr__(self, name: str):
         if name.startswith("_") or name in ("spec", "mechanism_signals", "wire_signals"):

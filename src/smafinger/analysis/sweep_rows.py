@@ -186,7 +186,8 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
 
     ``ids`` are the run ids found by :func:`check_block`; each run's id is computed again
     from the spec that actually ran, and a difference fails the run rather than mislabel
-    it. ``row`` makes a run's row (:func:`metrics_row`).
+    it. ``row`` makes a run's row (:func:`metrics_row`) from its metrics' signals: without
+    traces a run records only those (``run_spec(record="metrics")``; the same row).
     """
     warm_up()
     rows, traces, failed = [], [], 0
@@ -196,7 +197,7 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
             if run_id(spec) != rid:
                 raise RuntimeError(f"internal error: point {point} was checked as run {rid} but builds "
                                    f"run {run_id(spec)}")
-            r = row(run_spec(spec), traces_interval_s)
+            r = row(run_spec(spec, record="all" if traces_interval_s else "metrics"), traces_interval_s)
         except Exception as exc:  # noqa: BLE001 - reported per run, the sweep goes on
             r = error_row(exc)
             failed += 1

@@ -53,6 +53,7 @@ class RunSettings(NamedTuple):
     tol: float  #: a target is reached within this (rad or m)...
     hold_ticks: int  #: ...for this long
     pwm: int = PwmModel.EXACT  #: pwm.PwmModel: how the drive is applied
+    every_signal: bool = True  #: record every signal, else only signals.METRIC_FIELDS
 
 
 class Program(NamedTuple):
@@ -125,7 +126,7 @@ def _flush(mo, wo, out_i, next_out, run, wires, a, final, prev, now):
         if next_out != a and next_out != prev[0]:
             y, aux = interpolated(prev[1], prev[2], now[1], now[2], (next_out - prev[0]) / (a - prev[0]))
         record_sample(mo, wo, out_i, float(next_out) * run.tick_s, y, aux, src[6], src[7], src[5], src[3], src[4],
-                      wires, src[8])
+                      wires, src[8], run.every_signal)
         out_i += 1
         next_out += run.out_ticks
     return out_i, next_out

@@ -24,7 +24,7 @@ from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
-from .signals import MC, MECHANISM_FIELDS, WIRE_FIELDS, new_outputs, unrecorded
+from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, RECORD, WIRE_FIELDS, new_outputs, unrecorded
 
 
 
@@ -213,8 +213,10 @@ def _program(spec: RunSpec, model) -> Program:
     return Program(ticks_array(f"{prog.kind} start", cols[0]), level, duty)
 
 
-def kernel_args(spec: RunSpec) -> dict:
-    """The records and arrays the kernel takes (validated)."""
+def kernel_args(spec: RunSpec, record: str = "all") -> dict:
+    """The records and arrays the kernel takes (validated); ``record``: see :func:`run_spec`."""
+    if record not in RECORD:
+        raise ValueError(f"record = {record!r} is not one of {', '.join(RECORD)}")
     t_end = to_ticks("t_end_s", spec.t_end_s)
     dt = to_ticks("dt_s", spec.dt_s)
     if dt > t_end:
@@ -230,7 +232,8 @@ def kernel_args(spec: RunSpec) -> dict:
         update_ticks=to_ticks("controller_update_s", p.controller_update_s, allow_zero=True),
         pwm_ticks=to_ticks("pwm_period_s", p.pwm_period_s),
         tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
-        pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm))
+        pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm),
+        every_signal=record == "all")
     _check_output_size(spec, run)
     model = build_model(p)
     if spec.controller is not None:
@@ -268,15 +271,18 @@ def compile_kernel(spec: RunSpec) -> None:
     kernels(key, call_args)
 
 
-def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResult:
+def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> SimulationResult:
     """Run one validated spec; returns a :class:`~smafinger.results.SimulationResult`.
 
     ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
     :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
-    a thread, so that Ctrl-C is answered at once). ``engine``: see :mod:`.interpreted`."""
+    a thread, so that Ctrl-C is answered at once). ``engine``: see :mod:`.interpreted`.
+    ``record``: ``"all"`` signals, or only those the run's metrics read (``"metrics"``,
+    :data:`.signals.METRIC_FIELDS`: what a sweep's table needs; the same metrics, and the
+    result has only those signals) when the compiled kernel runs."""
     if engine not in ENGINES:
         raise ValueError(f"engine = {engine!r} is not one of {', '.join(ENGINES)}")
-    args = kernel_args(spec)
+    args = kernel_args(spec, record)
     if engine != "compiled" and not INTERPRETED:
         probe, key = _prepared(spec, args, samples=1)[:2]  # the outputs' types, not their size
         if interpreted.choose(engine, kernels.cached(key, probe), spec) == "interpreted":
@@ -305,7 +311,8 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled") -> SimulationResu
         spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=seg_actual * TICK_S,
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
         substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall,
-        engine="interpreted" if INTERPRETED else "compiled")
+        engine="interpreted" if INTERPRETED else "compiled",
+        recorded=None if args["run"].every_signal else METRIC_FIELDS)
 
 
 def describe_state(p: ParameterSet, state) -> str:

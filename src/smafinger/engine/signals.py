@@ -76,6 +76,13 @@ MechanismColumns.__module__ = WireColumns.__module__ = __name__
 MC = MechanismColumns(*range(len(MECHANISM_FIELDS)))
 WC = WireColumns(*range(len(WIRE_FIELDS)))
 
+#: what a run's metrics and plausibility checks read (``results.compute_metrics``): all a sweep's
+#: table needs. A run made with ``record="metrics"`` records these signals alone (the kernel
+#: writes 12 of the joint's 35 values a sample); a test checks that its metrics are the same.
+METRIC_FIELDS = ("t", "q", "T", "xi", "sigma", "electrical", "heat")
+#: what a run records: every signal, or the :data:`METRIC_FIELDS`
+RECORD = ("all", "metrics")
+
 #: mechanism label -> names of {q}, {q_ref}, {v}, {load}
 COORDINATE_NAMES = {
     "joint": {"q": "theta_deg", "q_ref": "theta_ref_deg", "v": "omega_deg_s", "load": "load_Nm"},
@@ -130,13 +137,24 @@ def structured(mech: np.ndarray, wires: np.ndarray) -> tuple[np.ndarray, np.ndar
 
 
 @njit(cache=True, forceinline=True)
-def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives, wires, geom):
-    """Write output sample ``i``: every signal, in its row (a test checks none is left NaN).
+def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, drives, wires, geom, every_signal):
+    """Write output sample ``i`` in the signals' rows: the :data:`METRIC_FIELDS`, and with
+    ``every_signal`` all the others (a test checks none is left NaN).
 
     ``wires``: the model's wire records, ``geom`` the geometry at the state (for the resistance).
     """
     mo[MC.t, i] = t_s
     mo[MC.q, i] = state.q
+    for w in range(len(state.wires)):
+        ws = state.wires[w]
+        wa = aux.wires[w]
+        wo[w, WC.T, i] = ws.T_C
+        wo[w, WC.xi, i] = wa.xi
+        wo[w, WC.sigma, i] = wa.sigma_Pa
+        wo[w, WC.electrical, i] = ws.electrical_J
+        wo[w, WC.heat, i] = ws.heat_J
+    if not every_signal:
+        return
     mo[MC.q_ref, i] = q_target
     mo[MC.v, i] = state.v
     mo[MC.load, i] = aux.load
@@ -145,16 +163,11 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
     for w in range(len(state.wires)):
         ws = state.wires[w]
         wa = aux.wires[w]
-        wo[w, WC.T, i] = ws.T_C
-        wo[w, WC.xi, i] = wa.xi
-        wo[w, WC.sigma, i] = wa.sigma_Pa
         wo[w, WC.force, i] = wa.force_N
         wo[w, WC.arm, i] = wa.arm_m
         wo[w, WC.spring, i] = wa.spring_m
         wo[w, WC.V, i] = drives[w]
         wo[w, WC.duty, i] = cmds[w].duty
-        wo[w, WC.electrical, i] = ws.electrical_J
-        wo[w, WC.heat, i] = ws.heat_J
         wo[w, WC.T_case, i] = ws.T_case_C
         wo[w, WC.enabled, i] = 1.0 if cmds[w].enabled else 0.0
         wo[w, WC.heating, i] = 1.0 if cmds[w].heating else 0.0
