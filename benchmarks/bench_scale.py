@@ -29,7 +29,8 @@ Usage::
 
     PYTHONPATH=src python benchmarks/bench_scale.py [--repeat 3] [--quick]
 
-``--quick`` skips the PWM SciPy case and runs 200 instead of 1,000 full cycles.
+``--quick`` skips the PWM SciPy case and runs 200 instead of 1,000 full cycles; ``--only
+parallel lean`` runs those sections alone.
 """
 
 from __future__ import annotations
@@ -282,30 +283,40 @@ def bench_client(repeat: int, n: int = 20000) -> dict:
     return res
 
 
+#: the sections, in the order they run: [1] parallel, [2] lean, [3] client, [4] scipy
+SECTIONS = ("parallel", "lean", "client", "scipy")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="repetitions per timing (median)")
     ap.add_argument("--quick", action="store_true", help="skip the PWM case (about 20 s of SciPy)")
+    ap.add_argument("--only", nargs="+", choices=SECTIONS, default=list(SECTIONS),
+                    help="run these sections only (default: all)")
     a = ap.parse_args()
     import os
     import platform
 
     print(f"smafinger scale benchmarks: python {platform.python_version()}, {os.cpu_count()} cpus, "
           f"load average {os.getloadavg()[0]:.2f} at start")
-    par = bench_parallel(a.repeat)
-    lean = bench_lean(a.quick)
-    cli = bench_client(a.repeat)
-    sci = bench_scipy(a.repeat, a.quick)
+    par = bench_parallel(a.repeat) if "parallel" in a.only else None
+    lean = bench_lean(a.quick) if "lean" in a.only else None
+    cli = bench_client(a.repeat) if "client" in a.only else None
+    sci = bench_scipy(a.repeat, a.quick) if "scipy" in a.only else {}
     print("\nsummary")
-    print(f"    parallel vs serial            : {par['ratio']:.2f}x warm, {par['cold']:.2f}x with pool start (goal >= 1.8x)")
-    for case, label in (("sweep", "reference"), ("sweep-long", "long step")):
+    if par:
+        print(f"    parallel vs serial            : {par['ratio']:.2f}x warm, {par['cold']:.2f}x with pool start "
+              "(goal >= 1.8x)")
+    for case, label in (("sweep", "reference"), ("sweep-long", "long step")) if lean else ():
         cyc = lean[case]
         print(f"    full cycles as a sweep ({label:9s}): {cyc['wall_s']:.1f} s, client peak {cyc['peak_MB']:.0f} MB "
               f"(goal 1,000 in <= 5 s, < 1 GB)")
-    print(f"    100 x 20 s results, peak      : full {lean['full']['peak_MB']:.0f} MB, compact "
-          f"{lean['compact']['peak_MB']:.0f} MB, streamed {lean['stream']['peak_MB']:.0f} MB")
-    print(f"    client per run                : {1e6 * cli['client_s']:.1f} us: keeps "
-          f"{cli['Fig. 8 run, 20 s open loop']:,.0f} workers busy at 7 ms per run (goal >= 0.8 x cores)")
+    if lean:
+        print(f"    100 x 20 s results, peak      : full {lean['full']['peak_MB']:.0f} MB, compact "
+              f"{lean['compact']['peak_MB']:.0f} MB, streamed {lean['stream']['peak_MB']:.0f} MB")
+    if cli:
+        print(f"    client per run                : {1e6 * cli['client_s']:.1f} us: keeps "
+              f"{cli['Fig. 8 run, 20 s open loop']:,.0f} workers busy at 7 ms per run (goal >= 0.8 x cores)")
     for name, r in sci.items():
         best = {f"{m} rtol {rt:g}": (ratio, err) for m, rt, _, err, ratio in r["baselines"]}
         shown = "; ".join(f"{k}: {v[0]:.1f}x (its error {v[1]:.4f} deg)" for k, v in best.items())
