@@ -63,6 +63,26 @@ def test_reduce_in_workers_serial_and_pool_agree():
     assert again == serial[:2]
 
 
+def _recorded(result):
+    return result.recorded, result.column_names, _summary(result)
+
+
+def test_a_batch_can_record_only_the_metrics_signals():
+    """record="metrics" reaches every run, in this process and in workers; the metrics are the same."""
+    from smafinger.engine.signals import METRIC_FIELDS
+
+    specs = _specs()[:3]
+    full = run_batch(specs, workers=1, reduce=_recorded)
+    for lean in (run_batch(specs, workers=1, reduce=_recorded, record="metrics"),
+                 run_batch(specs, workers=2, chunk_size=1, reduce=_recorded, record="metrics")):
+        for (rec, cols, summ), (rec_all, cols_all, summ_all) in zip(lean, full):
+            assert rec == METRIC_FIELDS and rec_all is None
+            assert "theta_deg" in cols and set(cols) < set(cols_all)
+            assert summ == summ_all
+    with pytest.raises(ValueError, match="record = 'some' is not one of all, metrics"):
+        run_batch(specs, workers=1, record="some")
+
+
 def test_dict_items_and_errors():
     items = [dict(params="paper2010", strategy="cooperative", profile="0:-30", t_end_s=0.5),
              dict(params="paper2010", strategy="cooperative", profile="0:-30", t_end_s=0.5, method="euler")]

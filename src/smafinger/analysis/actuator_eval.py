@@ -36,7 +36,8 @@ BAD_RESIDUAL = 1.0
 
 
 def coordinate_signal(result, column: str) -> np.ndarray:
-    """The batch workers' ``reduce``: only the coordinate column travels back."""
+    """The batch workers' ``reduce``: only the coordinate column travels back (one of the signals
+    a run made with ``record="metrics"`` has, which is how the fit runs them)."""
     return np.asarray(result.signal(column), dtype=np.float64)
 
 
@@ -121,7 +122,7 @@ class Evaluator:
         outputs: dict[tuple[int, int], np.ndarray | Exception] = {}
         reduce = partial(coordinate_signal, column=self.column)
         keys = [key for key, _ in items]
-        for j, ok, value in iter_batch([spec for _, spec in items], pool=self.pool, reduce=reduce):
+        for j, ok, value in iter_batch([spec for _, spec in items], pool=self.pool, reduce=reduce, record="metrics"):
             outputs[keys[j]] = value
             self.n_sims += 1
             if self.on_sim is not None:

@@ -89,7 +89,8 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
             failed[k] = f"{type(exc).__name__}: {exc}"
     curves: dict[int, np.ndarray] = {}
     keys = [k for k, _ in specs]
-    for j, ok, value in iter_batch([s for _, s in specs], pool=pool, reduce=partial(coordinate_signal, column=column)):
+    for j, ok, value in iter_batch([s for _, s in specs], pool=pool, reduce=partial(coordinate_signal, column=column),
+                                   record="metrics"):
         if ok:
             curves[keys[j]] = value
         else:

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from ..engine.run import DEFAULT_DT_S, simulate
+from ..engine.run import DEFAULT_DT_S, make_spec, run_spec
 from ..parameters import ParameterSet
 from ..profiles import VoltageProgram
 from .data import AngleCurve, DataError
@@ -73,8 +73,9 @@ def _t_end(t_last: float) -> float:
 
 def simulate_angle(params: ParameterSet, program: VoltageProgram, t_s: np.ndarray) -> np.ndarray:
     """Model joint angle [deg] at the times ``t_s`` under an open-loop program."""
-    r = simulate(params, strategy="open-loop", voltage=program, t_end_s=_t_end(float(t_s[-1])),
-                 output_interval_s=OUTPUT_INTERVAL_S, dt_s=DEFAULT_DT_S, engine="compiled")  # reference numerics
+    spec = make_spec(params, strategy="open-loop", voltage=program, t_end_s=_t_end(float(t_s[-1])),
+                     output_interval_s=OUTPUT_INTERVAL_S, dt_s=DEFAULT_DT_S)  # reference numerics
+    r = run_spec(spec, engine="compiled", record="metrics")  # the angle is one of the metrics' signals
     return np.interp(t_s, r.t, r.theta_deg)
 
 

@@ -34,6 +34,7 @@ from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itse
 from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
                     SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, warm_up)
 from .run import RunSpec, make_spec
+from .signals import RECORD
 
 #: signals kept in float64 by :func:`compact_signals`: time is the join key of every trace
 #: (float32 cannot hold 0.1 s steps exactly and resolves only 61 us at t = 1000 s). Every
@@ -172,8 +173,8 @@ class Compact:
 # one-call API
 # ---------------------------------------------------------------------------------------
 def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, reduce: Callable | None = None,
-               chunk_size: int | None = None, pool=None,
-               connect_timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator[tuple[int, bool, Any]]:
+               chunk_size: int | None = None, pool=None, connect_timeout_s: float = CONNECT_TIMEOUT_S,
+               record: str = "all") -> Iterator[tuple[int, bool, Any]]:
     """Run many simulations; yield ``(index, ok, value)`` for each as it finishes.
 
     ``runs`` is drawn lazily (a generator of specs is fine) and only a few chunks per worker
@@ -183,6 +184,8 @@ def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, re
     (validated here, as they are drawn) or recipes with a ``build()`` method (built in the
     worker). Other arguments as in :func:`run_batch`.
     """
+    if record not in RECORD:
+        raise ValueError(f"record = {record!r} is not one of {', '.join(RECORD)}")
     own = pool is None
     if own:
         pool = make_pool(workers, scheduler, connect_timeout_s)
@@ -191,7 +194,7 @@ def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, re
             n = len(runs) if hasattr(runs, "__len__") else 0
             chunk_size = auto_chunk_size(n, pool.slots) if n else 8
         items = ((i, r if not isinstance(r, dict) else as_spec(r)) for i, r in enumerate(runs))
-        for outcomes in pool.map_chunks(chunked(items, chunk_size), reduce):
+        for outcomes in pool.map_chunks(chunked(items, chunk_size), reduce, record):
             yield from outcomes
     except BaseException:
         if own:
@@ -203,7 +206,8 @@ def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, re
 
 def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, scheduler=None,
               reduce: Callable | None = None, chunk_size: int | None = None,
-              errors: str = "raise", pool=None, connect_timeout_s: float = CONNECT_TIMEOUT_S) -> list:
+              errors: str = "raise", pool=None, connect_timeout_s: float = CONNECT_TIMEOUT_S,
+              record: str = "all") -> list:
     """Run many simulations in parallel; the results in input order.
 
     Parameters
@@ -228,6 +232,10 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
         A pool from :func:`make_pool` to reuse (kept open), e.g. in a loop of batches.
     connect_timeout_s : float
         Time allowed to reach the Dask scheduler.
+    record : {"all", "metrics"}
+        The signals each run records: every one, or only those its metrics read (the results
+        then have only those; :func:`~smafinger.engine.run.run_spec`). ``"metrics"`` writes
+        about a third as much: for a ``reduce`` that needs no other signal.
 
     All results are held in the returned list: for large batches use :func:`iter_batch`
     (bounded memory) or a ``reduce``.
@@ -240,7 +248,8 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
     out: list[Any] = [None] * len(specs)
     failed: list[tuple[int, Exception]] = []
     for i, ok, value in iter_batch(specs, workers=workers, scheduler=scheduler, reduce=reduce,
-                                   chunk_size=chunk_size, pool=pool, connect_timeout_s=connect_timeout_s):
+                                   chunk_size=chunk_size, pool=pool, connect_timeout_s=connect_timeout_s,
+                                   record=record):
         out[i] = value
         if not ok:
             failed.append((i, value))

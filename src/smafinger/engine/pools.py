@@ -93,18 +93,19 @@ def build_spec(item) -> RunSpec:
     raise TypeError(f"a batch item must be a RunSpec or a recipe with build(), not {type(item).__name__}")
 
 
-def run_chunk(tasks: Sequence[Task], reduce: Callable | None = None) -> list[Outcome]:
+def run_chunk(tasks: Sequence[Task], reduce: Callable | None = None, record: str = "all") -> list[Outcome]:
     """Run a chunk of tasks here; the worker-side function of :func:`run_batch`.
 
     Each outcome is ``(key, True, value)`` with ``value = reduce(result)`` (the
     :class:`~smafinger.results.SimulationResult` itself without ``reduce``), or
-    ``(key, False, exception)`` if building the spec, the run or ``reduce`` raised.
+    ``(key, False, exception)`` if building the spec, the run or ``reduce`` raised. ``record``:
+    the signals each run records (:func:`~smafinger.engine.run.run_spec`).
     """
     warm_up()
     out: list[Outcome] = []
     for key, item in tasks:
         try:
-            res = run_spec(build_spec(item))
+            res = run_spec(build_spec(item), record=record)
             out.append((key, True, reduce(res) if reduce is not None else res))
         except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
             out.append((key, False, exc))
@@ -184,9 +185,10 @@ class SerialPool:
         for item in items:
             yield fn(item)
 
-    def map_chunks(self, chunks: Iterable[list[Task]], reduce: Callable | None = None) -> Iterator[list[Outcome]]:
+    def map_chunks(self, chunks: Iterable[list[Task]], reduce: Callable | None = None,
+                   record: str = "all") -> Iterator[list[Outcome]]:
         """Each chunk's outcomes (:func:`run_chunk`) as soon as it finishes."""
-        return self.map_tasks(partial(run_chunk, reduce=reduce), chunks)
+        return self.map_tasks(partial(run_chunk, reduce=reduce, record=record), chunks)
 
     def close(self, cancel: bool = False) -> None:
         pass
