@@ -24,7 +24,8 @@ FAST = dict(method="exponential", dt_s=5e-3, pwm="averaged")
 
 
 def _same(a, b):
-    return a.mechanism_signals.tobytes() == b.mechanism_signals.tobytes() and a.wire_signals.tobytes() == b.wire_signals.tobytes()
+    return (a.mechanism_signals.tobytes() == b.mechanism_signals.tobytes()
+            and a.wire_signals.tobytes() == b.wire_signals.tobytes())
 
 
 def test_authors_ode4_is_rk4_when_no_wire_is_switched():
