@@ -34,7 +34,7 @@ from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itse
 from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
                     SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, warm_up)
 from .run import RunSpec, make_spec
-from .signals import RECORD
+from .signals import every_signal
 
 #: signals kept in float64 by :func:`compact_signals`: time is the join key of every trace
 #: (float32 cannot hold 0.1 s steps exactly and resolves only 61 us at t = 1000 s). Every
@@ -184,8 +184,7 @@ def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, re
     (validated here, as they are drawn) or recipes with a ``build()`` method (built in the
     worker). Other arguments as in :func:`run_batch`.
     """
-    if record not in RECORD:
-        raise ValueError(f"record = {record!r} is not one of {', '.join(RECORD)}")
+    every_signal(record)  # a bad value is refused here, before any pool is made
     own = pool is None
     if own:
         pool = make_pool(workers, scheduler, connect_timeout_s)

@@ -24,8 +24,7 @@ from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
-from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, RECORD, WIRE_FIELDS, new_outputs, unrecorded
-
+from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, WIRE_FIELDS, check_recorded, every_signal, new_outputs
 
 
 class SimulationError(RuntimeError):
@@ -215,8 +214,6 @@ def _program(spec: RunSpec, model) -> Program:
 
 def kernel_args(spec: RunSpec, record: str = "all") -> dict:
     """The records and arrays the kernel takes (validated); ``record``: see :func:`run_spec`."""
-    if record not in RECORD:
-        raise ValueError(f"record = {record!r} is not one of {', '.join(RECORD)}")
     t_end = to_ticks("t_end_s", spec.t_end_s)
     dt = to_ticks("dt_s", spec.dt_s)
     if dt > t_end:
@@ -233,7 +230,7 @@ def kernel_args(spec: RunSpec, record: str = "all") -> dict:
         pwm_ticks=to_ticks("pwm_period_s", p.pwm_period_s),
         tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
         pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm),
-        every_signal=record == "all")
+        every_signal=every_signal(record))
     _check_output_size(spec, run)
     model = build_model(p)
     if spec.controller is not None:
@@ -277,9 +274,8 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
     ``progress``: ``True`` shows a bar on a terminal (plain lines otherwise), or give a
     :class:`smafinger.progress.Display` (even one that shows nothing: the run then goes on in
     a thread, so that Ctrl-C is answered at once). ``engine``: see :mod:`.interpreted`.
-    ``record``: ``"all"`` signals, or only those the run's metrics read (``"metrics"``,
-    :data:`.signals.METRIC_FIELDS`: what a sweep's table needs; the same metrics, and the
-    result has only those signals) when the compiled kernel runs."""
+    ``record``: ``"all"`` signals, or (compiled) only those its metrics read (``"metrics"``,
+    :data:`.signals.METRIC_FIELDS`: the same metrics; the result has only those signals)."""
     if engine not in ENGINES:
         raise ValueError(f"engine = {engine!r} is not one of {', '.join(ENGINES)}")
     args = kernel_args(spec, record)
@@ -303,10 +299,7 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
     wall = time.perf_counter() - t0
     if counters.status != 0:
         raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
-    missing = unrecorded(mech)
-    if missing:
-        raise RuntimeError(f"internal error: the run ended with {missing} of its {mech.shape[1]} output samples "
-                           "not recorded")
+    check_recorded(mech)
     return SimulationResult(
         spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=seg_actual * TICK_S,
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),

@@ -114,16 +114,26 @@ def new_outputs(n_samples: int, n_wires: int) -> tuple[np.ndarray, np.ndarray]:
     """Output arrays for a run: the mechanism's (fields x samples) and the wires' (wires x fields
     x samples), float64, rows :data:`MC` and :data:`WC`. Only the time row is set (NaN): a sample
     is recorded whole (:func:`record_sample`), so a NaN time marks a sample not recorded
-    (:func:`unrecorded`); the other rows are left as allocated (filling 17 MB for the 60 s
+    (:func:`check_recorded`); the other rows are left as allocated (filling 17 MB for the 60 s
     full cycle cost 1.5 ms a run)."""
     mech = np.empty((len(MECHANISM_FIELDS), n_samples))
     mech[MC.t] = np.nan
     return mech, np.empty((n_wires, len(WIRE_FIELDS), n_samples))
 
 
-def unrecorded(mech: np.ndarray) -> int:
-    """How many samples of the outputs (:func:`new_outputs`) were not recorded."""
-    return int(np.count_nonzero(np.isnan(mech[MC.t])))
+def check_recorded(mech: np.ndarray) -> None:
+    """Raise if a sample of the outputs (:func:`new_outputs`) was not recorded (its time is NaN)."""
+    missing = int(np.count_nonzero(np.isnan(mech[MC.t])))
+    if missing:
+        raise RuntimeError(f"internal error: the run ended with {missing} of its {mech.shape[1]} output samples "
+                           "not recorded")
+
+
+def every_signal(record: str) -> bool:
+    """Whether a run made with ``record`` (one of :data:`RECORD`) records every signal."""
+    if record not in RECORD:
+        raise ValueError(f"record = {record!r} is not one of {', '.join(RECORD)}")
+    return record == "all"
 
 
 def structured(mech: np.ndarray, wires: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -145,6 +155,12 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
     """
     mo[MC.t, i] = t_s
     mo[MC.q, i] = state.q
+    if every_signal:
+        mo[MC.q_ref, i] = q_target
+        mo[MC.v, i] = state.v
+        mo[MC.load, i] = aux.load
+        mo[MC.stuck, i] = 1.0 if stuck else 0.0
+        mo[MC.segment, i] = segment
     for w in range(len(state.wires)):
         ws = state.wires[w]
         wa = aux.wires[w]
@@ -153,16 +169,8 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
         wo[w, WC.sigma, i] = wa.sigma_Pa
         wo[w, WC.electrical, i] = ws.electrical_J
         wo[w, WC.heat, i] = ws.heat_J
-    if not every_signal:
-        return
-    mo[MC.q_ref, i] = q_target
-    mo[MC.v, i] = state.v
-    mo[MC.load, i] = aux.load
-    mo[MC.stuck, i] = 1.0 if stuck else 0.0
-    mo[MC.segment, i] = segment
-    for w in range(len(state.wires)):
-        ws = state.wires[w]
-        wa = aux.wires[w]
+        if not every_signal:
+            continue
         wo[w, WC.force, i] = wa.force_N
         wo[w, WC.arm, i] = wa.arm_m
         wo[w, WC.spring, i] = wa.spring_m
