@@ -11,8 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
+from ..jit import njit
 from ..model.kinetics import COOLING, HEATING, branch_start, martensite_fraction
 from ..parameters import ParameterSet
 from .data import StrainCurve

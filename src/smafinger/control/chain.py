@@ -24,8 +24,7 @@ import math
 from enum import IntEnum
 from typing import NamedTuple
 
-from numba import njit
-
+from ..jit import njit
 from ..parameters.options import IntegralReset
 from .controller import integrating_flag, phase_commands
 from .fuzzy import FuzzyPID, fuzzy_output

@@ -6,9 +6,8 @@ wire its drive level and duty. Both return a tuple of
 :class:`~smafinger.control.strategies.Command`, one per wire.
 """
 
-from numba import njit
-
 from ..engine.tuples import filled, set_item
+from ..jit import njit
 from ..parameters.options import AntiWindup, DampingSwitch
 from .pid import pid_output, saturated_against
 from .strategies import Command, is_enabled, wire_command

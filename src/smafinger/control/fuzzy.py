@@ -27,8 +27,8 @@ wires by the paper's phase selection (Sec. 2.6).
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from ..jit import njit
 from .pid import pid_output
 
 #: fuzzy sets of each input, in order (rows: e, columns: de/dt)

@@ -10,7 +10,7 @@ target gives no derivative kick). A wire whose contraction lowers q uses the err
 opposite sign (the paper's antagonist, -DC%).
 """
 
-from numba import njit
+from ..jit import njit
 
 
 @njit(cache=True, forceinline=True)

@@ -27,9 +27,8 @@ estimate it from the resistance; here it is measured directly).
 
 from typing import NamedTuple
 
-from numba import njit
-
 from ..engine.tuples import set_item
+from ..jit import njit
 from .strategies import Command, is_enabled
 
 

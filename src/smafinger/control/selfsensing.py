@@ -22,7 +22,7 @@ too: the controller never sees q.
 
 from typing import NamedTuple
 
-from numba import njit
+from ..jit import njit
 
 
 class ResistanceMap(NamedTuple):

@@ -14,10 +14,9 @@ sensors.
 import math
 from typing import NamedTuple
 
-from numba import njit
-
 from ..engine.rhs import geometry_at
 from ..engine.tuples import filled, set_item
+from ..jit import njit
 from ..model.resistance import resistance_at
 
 

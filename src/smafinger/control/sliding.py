@@ -19,7 +19,7 @@ the plant state's error integral (reset per segment like the PID's, frozen by an
 
 from typing import NamedTuple
 
-from numba import njit
+from ..jit import njit
 
 
 

@@ -26,8 +26,7 @@ Which wires are enabled is a bit mask (bit i: wire i); :data:`AUTO` lets the str
 from enum import IntEnum
 from typing import NamedTuple
 
-from numba import njit
-
+from ..jit import njit
 from .pid import clamp_duty
 
 

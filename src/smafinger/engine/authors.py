@@ -29,12 +29,13 @@ stages and only reads the PWM wave at the stage's phase.
 
 from typing import NamedTuple
 
-from numba import njit, types
+from numba import types
 from numba.extending import overload
 
 from ..control.controller import integrating_flag, phase_commands
 from ..control.pid import on_time, pid_output
 from ..control.strategies import Strategy
+from ..jit import njit
 from ..model.heat import wire_temperature_rate
 from ..model.hysteresis import AUTHORS_CALLS
 from ..model.hysteresis_authors import call_record, committed_call

@@ -9,8 +9,7 @@ Linear interpolation adds an error of h^2/8 max|y''| at most, below the step's o
 at first order.
 """
 
-from numba import njit
-
+from ..jit import njit
 from ..model.records import Aux, State, WireAux, WireState
 from .rhs import ZERO_WIRE_AUX
 from .tuples import filled, set_item

@@ -41,8 +41,7 @@ from enum import IntEnum
 
 import math
 
-from numba import njit
-
+from ..jit import njit
 from ..model.records import State, WireState
 from ..parameters.options import StressLaw
 from .authors import call_branches, commit_calls, stage_inputs

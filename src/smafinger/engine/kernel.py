@@ -16,12 +16,12 @@ violation). The loop itself only sequences these.
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
 from ..control.controller import program_commands, viscous_coefficient
 from ..control.interface import control_tick, initial_control_state
 from ..control.pid import pwm_edge
 from ..control.strategies import Strategy
+from ..jit import njit
 from ..model.hysteresis_memory import STACK_COLUMNS
 from ..parameters.options import IntegralReset
 from .authors import NO_MAJOR_STEP, DerivativeMemory, major_commands

@@ -35,8 +35,7 @@ from __future__ import annotations
 import math
 from enum import IntEnum
 
-from numba import njit
-
+from ..jit import njit
 from .clock import TICKS_PER_S
 
 

@@ -10,8 +10,7 @@ a wire's stress is solved from its strain, temperature and xi, and its state str
 import math
 from typing import NamedTuple
 
-from numba import njit
-
+from ..jit import njit
 from ..model.dynamics import angular_acceleration, external_load, wire_load
 from ..model.heat import electrical_power, joule_power_per_m
 from ..model.kinematics import WireGeometry, route

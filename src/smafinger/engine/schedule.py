@@ -8,9 +8,8 @@ starts the segments that are due; :func:`track_reach` records when each target w
 import math
 from typing import NamedTuple
 
-from numba import njit
-
 from ..control.strategies import AUTO, NO_WIRE, RELEASE_XI, Strategy, agonist_of
+from ..jit import njit
 from ..model.wire import wire_stress_xi
 from .tuples import with_field
 

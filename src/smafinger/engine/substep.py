@@ -8,10 +8,9 @@ and the stick/slip state (Eq. 2) are decided; then the state is advanced and che
 import math
 from typing import NamedTuple
 
-from numba import njit
-
 from ..control.pid import on_time, pwm_output
 from ..control.strategies import Command, opposing_wires_driven
+from ..jit import njit
 from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.hysteresis_authors import initial_calls_record

@@ -14,7 +14,7 @@ stress never goes negative.
 
 import math
 
-from numba import njit
+from ..jit import njit
 
 
 @njit(cache=True, forceinline=True)

@@ -18,8 +18,10 @@ hold a slider the same way (:func:`end_stop`).
 
 from typing import NamedTuple
 
-from numba import njit, types
+from numba import types
 from numba.extending import overload
+
+from ..jit import njit
 
 
 class JointLoad(NamedTuple):

@@ -16,8 +16,7 @@ heating ones while the wire's controller is in its heating phase and the cooling
 (Sec. 3.2, MODEL-NOTES).
 """
 
-from numba import njit
-
+from ..jit import njit
 from ..parameters.options import JouleHeating, ThermalModel
 
 #: Stefan-Boltzmann constant [W/(m^2 K^4)] (CODATA 2018, exact)

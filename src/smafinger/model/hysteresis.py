@@ -39,8 +39,8 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from ..jit import njit
 from .hysteresis_memory import STACK_COLUMNS, branch_target, memory_update
 from .kinetics import (COOLING, HEATING, HOLD, branch_start, g_cooling, g_cooling_upper_bound, g_heating,
                        g_heating_lower_bound, next_branch)

@@ -36,8 +36,7 @@ their parent branch; ``direction``, ``x0`` and ``slope`` hold the last call's br
 
 import math
 
-from numba import njit
-
+from ..jit import njit
 from .hysteresis import AUTHORS_CALLS, BranchRecord
 from .kinetics import COOLING, HEATING, branch_start
 RAW = False

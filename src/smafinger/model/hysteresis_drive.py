@@ -12,8 +12,8 @@ update: it shows what the engine's right-hand side sees inside a sub-step.
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from ..jit import njit
 from .hysteresis import (
     AUTHORS2020, DEADBAND, DEFAULT_CAPACITY, DEFAULT_RULE, drive_direction, initial_record,
     new_stack, rule_code, update_memory, xi_on_branch,

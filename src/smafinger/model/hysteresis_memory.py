@@ -33,8 +33,7 @@ kept; the merged loops' return points are lost (counted in ``merges``).
 
 import math
 
-from numba import njit
-
+from ..jit import njit
 from .kinetics import g_cooling, g_heating
 
 S_TAU_A, S_TAU_M, S_XI, S_G_A, S_G_M, S_X0, S_G0, S_SLOPE = range(8)

@@ -21,8 +21,10 @@ path shortens by exactly the slider's displacement: d path / d x = -1.
 import math
 from typing import NamedTuple
 
-from numba import njit, types
+from numba import types
 from numba.extending import overload
+
+from ..jit import njit
 
 
 class TendonRoute(NamedTuple):

@@ -16,7 +16,7 @@ rules are in :mod:`smafinger.model.hysteresis`.
 
 import math
 
-from numba import njit
+from ..jit import njit
 
 HOLD = 0
 HEATING = 1

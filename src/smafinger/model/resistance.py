@@ -26,8 +26,7 @@ alpha_A = 2e-4 /K, alpha_M = 3e-4 /K at T_ref = 20 degC, the resistance paramete
 with the MAS model for actuator-grade NiTi wire (docs/controllers.md, "Self-sensing").
 """
 
-from numba import njit
-
+from ..jit import njit
 from ..parameters.options import StressLaw
 from .constitutive import rate_law_modulus, youngs_modulus
 from .hysteresis import xi_on_branch

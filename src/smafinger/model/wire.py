@@ -5,8 +5,7 @@ martensite fraction the kinetics branch (Eqs. 9-10), its stress the constitutive
 rate or algebraic form) and its temperature the heat balance (Eq. 11).
 """
 
-from numba import njit
-
+from ..jit import njit
 from ..parameters.options import StressLaw
 from .constitutive import rate_law_modulus, secant_modulus, stress_rate, youngs_modulus
 from .heat import casing_temperature_rate, latent_heat_rate, wire_temperature_rate
