@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
 import sys
 
 import numpy as np
@@ -51,6 +54,25 @@ def test_parallel_results_bit_identical_to_single_runs():
         assert np.array_equal(a.segment_reached_s, b.segment_reached_s, equal_nan=True)
         assert (a.substeps, a.interlock_violations) == (b.substeps, b.interlock_violations)
         assert _summary(a) == _summary(b)
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="a forkserver is a POSIX start method")
+def test_workers_fork_warm_from_the_forkserver():
+    """Local workers fork from a forkserver that loaded the kernel (engine/forking.py): in each
+    worker it was loaded by neither the worker nor the client, but before either asked. A fresh
+    process, so that no forkserver is left from another test."""
+    pools.warm_up()  # the kernel in numba's disk cache
+    code = ("import json, os\nfrom smafinger.engine import batch, pools\n"
+            "pool = batch.LocalPool(2).start()\n"
+            "print(json.dumps({'client': os.getpid(), 'workers': list(pool.map_tasks(pools.warmed_in, range(4)))}))\n"
+            "pool.close()\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    got = json.loads(proc.stdout)
+    assert len(got["workers"]) == 4
+    for pid, loaded_in in got["workers"]:
+        assert loaded_in is not None and loaded_in not in (pid, got["client"])
 
 
 def test_reduce_in_workers_serial_and_pool_agree():

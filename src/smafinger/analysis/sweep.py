@@ -262,6 +262,8 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     before anything is made. Returns a :class:`SweepReport`.
     """
     t_start = time.perf_counter()
+    if scheduler is None:
+        batch.start_forkserver(workers)  # local workers start warm from it, given the time
     if not isinstance(spec, SweepSpec):
         spec = load_spec(spec, max_runs=max_runs)
     out = Path(out) if out is not None else Path(f"{spec.name}.parquet")

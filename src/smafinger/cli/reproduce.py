@@ -24,6 +24,9 @@ def reproduce(
     progress: Optional[bool] = progress_option(),
 ):
     """Run the paper's scenarios; write its figures, a CSV per run, summary.json and report.md."""
+    from ..engine.forking import start_forkserver  # the standard library only
+
+    start_forkserver(workers)  # its imports and kernel loading overlap this process's own
     from ..paper.runner import reproduce as run
     from ..paper.runner import select
 

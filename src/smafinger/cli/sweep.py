@@ -54,10 +54,14 @@ def sweep(
     """
     from rich.console import Console
 
+    from ..engine.forking import start_forkserver  # the standard library only
+
+    _check_options(workers, max_runs, progress_interval, scheduler, mat)
+    if scheduler is None:
+        start_forkserver(workers)  # its imports and kernel loading overlap this process's own
     from ..analysis.sweep import load_spec, run_sweep
     from ..engine.batch import check_scheduler
 
-    _check_options(workers, max_runs, progress_interval, scheduler, mat)
     sweep_spec = load_spec(spec, max_runs=max_runs)
     if scheduler is not None:
         scheduler = check_scheduler(scheduler, connect_timeout)  # fail fast, before any work

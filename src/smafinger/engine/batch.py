@@ -32,7 +32,8 @@ import numpy as np
 
 from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itself is imported on use)
 from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
-                    SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, warm_up)
+                    SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, start_forkserver,
+                    warm_up)
 from .run import RunSpec, make_spec
 from .signals import every_signal
 

@@ -6,10 +6,10 @@ worker in flight: the items are drawn lazily from their iterable, so a batch of 
 is never all in memory at once.
 
 - :class:`SerialPool`: one after the other in this process;
-- :class:`LocalPool`: worker processes (``forkserver`` where available, else ``spawn``),
-  each warmed up once (numba's compiled kernel loaded from its on-disk cache) and each
-  watching its client: if the client dies, even by SIGKILL, its workers exit at once, and
-  with them the forkserver and multiprocessing's resource tracker;
+- :class:`LocalPool`: worker processes (``forkserver`` where available, else ``spawn``;
+  :mod:`.forking`), each warm (numba's compiled kernel loaded from its on-disk cache, once in
+  the forkserver) and each watching its client: if the client dies, even by SIGKILL, its
+  workers exit at once, and with them the forkserver and multiprocessing's resource tracker;
 - :class:`~.dask_pool.DaskPool`: the workers of a ``dask.distributed`` cluster (optional extra,
   ``pip install smafinger[distributed]``; imported only when used). **Dask workers run
   pickled code sent by the client: connect only to a cluster you trust.**
@@ -24,7 +24,8 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from functools import partial
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
-from .run import RunSpec, make_spec, run_spec
+from .forking import available_cores, mp_context, start_forkserver  # noqa: F401 (re-exported)
+from .run import RunSpec, kernel_cached, make_spec, run_spec
 
 #: a task: (key, spec or recipe); a chunk: a list of tasks; a task's outcome: (key, ok, value)
 Task = tuple[Any, Any]
@@ -34,7 +35,9 @@ IN_FLIGHT_PER_SLOT = 2
 #: default time to connect to a Dask scheduler (CLI: --connect-timeout)
 CONNECT_TIMEOUT_S = 10.0
 
-_WARM = False
+#: the process that loaded the kernel into this one's memory: this one, or the forkserver a worker
+#: was forked from (:mod:`.forkserver_warm`); None until then
+_WARMED_IN: int | None = None
 
 
 class BatchError(RuntimeError):
@@ -68,16 +71,30 @@ def warm_up() -> bool:
 
     Returns True if this call did the work, False if the process was already warm.
     """
-    global _WARM
-    if _WARM:
+    global _WARMED_IN
+    if _WARMED_IN is not None:
         return False
-    run_spec(make_spec("paper2010", "cooperative", "0:-30", t_end_s=0.002))
-    _WARM = True
+    run_spec(_warm_up_spec())
+    _WARMED_IN = os.getpid()
     return True
 
 
+def _warm_up_spec() -> RunSpec:
+    return make_spec("paper2010", "cooperative", "0:-30", t_end_s=0.002)
+
+
+def warm_up_cached() -> bool:
+    """Whether :func:`warm_up` would load the kernel (from numba's disk cache), not compile it."""
+    return kernel_cached(_warm_up_spec())
+
+
 def is_warm() -> bool:
-    return _WARM
+    return _WARMED_IN is not None
+
+
+def warmed_in(_=None) -> tuple[int, int | None]:
+    """(this process's id, the id of the process that loaded the kernel here: :data:`_WARMED_IN`)."""
+    return os.getpid(), _WARMED_IN
 
 
 def build_spec(item) -> RunSpec:
@@ -148,26 +165,6 @@ def _noop(_):
     return os.getpid()
 
 
-def available_cores() -> int:
-    """Cores this process may run on (affinity-aware)."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # pragma: no cover - not Linux
-        return max(1, os.cpu_count() or 1)
-
-
-def _mp_context():
-    import multiprocessing as mp
-
-    methods = mp.get_all_start_methods()
-    if "forkserver" in methods:
-        ctx = mp.get_context("forkserver")
-        # import numpy, numba and the engine once in the server; workers fork from it
-        ctx.set_forkserver_preload([__name__])
-        return ctx
-    return mp.get_context("spawn")  # pragma: no cover - Windows / macOS fallback
-
-
 # ---------------------------------------------------------------------------------------
 # pools
 # ---------------------------------------------------------------------------------------
@@ -207,10 +204,11 @@ class LocalPool(SerialPool):
         self.slots = available_cores() if workers is None else workers
         if self.slots < 1:
             raise ValueError(f"workers = {workers!r} must be >= 1")
+        start_forkserver(self.slots)  # its imports and warm-up overlap the warm-up here
         # compile here first if numba's disk cache is stale: the workers then load it
         # instead of compiling all at once
         warm_up()
-        self._ex = ProcessPoolExecutor(max_workers=self.slots, mp_context=_mp_context(),
+        self._ex = ProcessPoolExecutor(max_workers=self.slots, mp_context=mp_context(),
                                        initializer=_init_local_worker)
 
     def describe(self) -> str:

@@ -238,21 +238,16 @@ def kernel_args(spec: RunSpec, record: str = "all") -> dict:
     return dict(model=model, run=run, segs=_segments(spec), prog=_program(spec, model))
 
 
-def _kernel_args_tuple(args: dict, mech, wires, seg_actual, seg_reached) -> tuple:
-    return (args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached,
-            memory_stacks(wires.shape[1]))
-
-
 def _prepared(spec: RunSpec, args: dict | None = None, samples: int | None = None) -> tuple:
     """(kernel arguments, kernel key, outputs, segment starts and reaches); ``samples=1``: arguments
     of the same types without the run's outputs allocated (to look the kernel up)."""
     args = kernel_args(spec) if args is None else args
     n = args["run"].t_end_ticks // args["run"].out_ticks + 1 if samples is None else samples
     mech, wires = new_outputs(n, len(spec.params.wire_names))
-    n_seg = len(spec.profile.segments)
-    seg_actual = np.full(n_seg, -1, dtype=np.int64)
-    seg_reached = np.full(n_seg, -1, dtype=np.int64)
-    call_args = _kernel_args_tuple(args, mech, wires, seg_actual, seg_reached)
+    seg_actual = np.full(len(spec.profile.segments), -1, dtype=np.int64)
+    seg_reached = seg_actual.copy()
+    call_args = (args["model"], args["run"], args["segs"], args["prog"], mech, wires, seg_actual, seg_reached,
+                 memory_stacks(wires.shape[1]))
     key = (spec.params.mechanism, len(spec.params.wire_names), type(args["model"].controller))
     return call_args, key, mech, wires, seg_actual, seg_reached
 
@@ -260,6 +255,12 @@ def _prepared(spec: RunSpec, args: dict | None = None, samples: int | None = Non
 def kernel_key(spec: RunSpec) -> tuple:
     """What the compiled kernel depends on: the mechanism, the wire count, the controller's record type."""
     return _prepared(spec, samples=1)[1]
+
+
+def kernel_cached(spec: RunSpec, args: dict | None = None) -> bool:
+    """Whether the kernel ``spec`` needs is loaded here or in numba's disk cache (no compile)."""
+    probe, key = _prepared(spec, args, samples=1)[:2]  # the outputs' types, not their size
+    return kernels.cached(key, probe)
 
 
 def compile_kernel(spec: RunSpec) -> None:
@@ -280,8 +281,7 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
         raise ValueError(f"engine = {engine!r} is not one of {', '.join(ENGINES)}")
     args = kernel_args(spec, record)
     if engine != "compiled" and not INTERPRETED:
-        probe, key = _prepared(spec, args, samples=1)[:2]  # the outputs' types, not their size
-        if interpreted.choose(engine, kernels.cached(key, probe), spec) == "interpreted":
+        if interpreted.choose(engine, kernel_cached(spec, args), spec) == "interpreted":
             if engine == "interpreted":
                 return interpreted.run_interpreted(spec)
             interpreted.build_in_background(spec)
