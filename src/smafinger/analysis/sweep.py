@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import json
 import math
-import shutil
 import time
 from dataclasses import dataclass
 from functools import partial
@@ -56,6 +55,7 @@ from .sweep_parse import load_spec, parse_spec
 from .sweep_progress import Progress
 from .sweep_rows import (METRIC_COLUMNS, MOTION_THRESHOLD_DEG, TRACE_COLUMNS, check_block, error_row,  # noqa: F401
                          metrics_row, run_block)
+from .sweep_size import SweepSize, SweepSizeError, check_size, max_t_end, sweep_size  # noqa: F401 (re-exported)
 from .sweep_spec import (DEFAULT_MAX_RUNS, RUN_ID_SCHEMA, Run, SweepSpec, SweepSpecError, Vary,  # noqa: F401
                          canonical_run, run_id)
 from .sweep_store import IdIndex, StoreError, clean_stale, parts_dir, traces_path, write_part
@@ -74,59 +74,6 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted after {done} of {total} runs; finished runs are saved in "
                          f"{parts} - run the same sweep again to resume")
         self.done, self.total, self.parts = done, total, parts
-
-
-class SweepSizeError(SweepSpecError):
-    """The sweep is larger than allowed (``max_runs``) or than the free disk space."""
-
-
-@dataclass(frozen=True)
-class SweepSize:
-    """A sweep's size, known before anything is made; bytes are uncompressed estimates."""
-
-    runs: int
-    table_bytes: int
-    traces_bytes: int
-    client_bytes: int
-
-    def describe(self) -> str:
-        tr = f", traces {_human(self.traces_bytes)}" if self.traces_bytes else ""
-        return (f"{self.runs:,} runs (estimated: table {_human(self.table_bytes)}{tr}, "
-                f"client memory {_human(self.client_bytes)})")
-
-
-def _human(n: float) -> str:
-    for unit in ("B", "kB", "MB", "GB", "TB"):
-        if n < 1000 or unit == "TB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
-        n /= 1000
-    return ""  # pragma: no cover
-
-
-def sweep_size(spec: SweepSpec, traces: bool) -> SweepSize:
-    """The size of a sweep and its outputs, from the spec alone (no point is made)."""
-    n = spec.size()
-    profile = spec.base.get("profile")
-    n_seg = profile.count(",") + 1 if isinstance(profile, str) else 1
-    n_cols = 2 + len(spec.vary) + len(METRIC_COLUMNS) + 4 * n_seg
-    samples = int(min(_max_t_end(spec) / spec.traces_interval_s, 1e18)) + 1  # 1e308 s: refused later, no overflow
-    per_sample = 8 + 8 + 4 * (len(TRACE_COLUMNS) - 1) + 4  # t_s, point, float32 signals, run_id
-    lhs = 8 * n * len(spec.vary) if spec.mode == "lhs" else 0
-    return SweepSize(n, n * n_cols * 8, n * samples * per_sample if traces else 0, n * 45 + lhs)
-
-
-def check_size(spec: SweepSpec, out: Path, traces: bool, max_runs: int) -> SweepSize:
-    """Refuse (:class:`SweepSizeError`, naming the size) a sweep above ``max_runs`` runs or
-    whose outputs cannot fit in the free space of ``out``'s folder."""
-    size = sweep_size(spec, traces)
-    if size.runs > max_runs:
-        raise SweepSizeError(f"{spec.source}: the sweep has {size.describe()}; that is above the limit of "
-                             f"{max_runs:,} runs: raise --max-runs to run it")
-    free = shutil.disk_usage(out.parent if str(out.parent) else ".").free
-    if size.table_bytes + size.traces_bytes > free:
-        raise SweepSizeError(f"{spec.source}: the sweep has {size.describe()}, more than the "
-                             f"{_human(free)} free in {out.parent or '.'}")
-    return size
 
 
 # ---------------------------------------------------------------------------------------
@@ -362,7 +309,7 @@ def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Che
     if not unchanged:
         varied = [v.name for v in spec.vary]
         if traces:
-            samples = max(1, round(_max_t_end(spec) / spec.traces_interval_s) + 1)
+            samples = max(1, round(max_t_end(spec) / spec.traces_interval_s) + 1)
             write_traces(traces_path(out), finished, samples,
                          {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s, "version": __version__})
         write_table(out, finished, points, varied, checked.n_segments,
@@ -378,14 +325,6 @@ def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Che
             pdir.rmdir()
         except OSError:
             pass
-
-
-def _max_t_end(spec: SweepSpec) -> float:
-    t_end = spec.base.get("t_end_s", 20.0)
-    for v in spec.vary:
-        if "t_end_s" in v.fields:
-            t_end = max(v.values) if v.values is not None else v.high
-    return float(t_end)
 
 
 def read_results(path: str | Path, with_timing: bool = True):
