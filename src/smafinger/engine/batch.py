@@ -269,6 +269,6 @@ def __getattr__(name: str):
 
 
 __all__ = ["run_batch", "iter_batch", "run_chunk", "make_pool", "SerialPool", "LocalPool", "DaskPool",
-           "BatchError", "SchedulerError", "DistributedMissing", "specs_product", "as_spec", "warm_up", "start_forkserver",
-           "available_cores", "auto_chunk_size", "chunked", "Compact", "CompactResult", "compact_signals",
-           "check_scheduler", "FLOAT64_SIGNALS"]
+           "BatchError", "SchedulerError", "DistributedMissing", "specs_product", "as_spec", "warm_up",
+           "start_forkserver", "available_cores", "auto_chunk_size", "chunked", "Compact", "CompactResult",
+           "compact_signals", "check_scheduler", "FLOAT64_SIGNALS"]
