@@ -58,6 +58,20 @@ def test_reproduce_glob_selection_serial(tmp_path):
     assert "extension: return from -30 to -40 deg faster" in (out / "report.md").read_text()
 
 
+def test_figures_and_csvs_written_by_workers_are_those_written_here(tmp_path):
+    """The figures and CSVs go to the worker pool (paper/runner.py): the files are byte for byte
+    those one process writes. Two figures (Fig. 8 and Fig. 13), so both workers draw."""
+    only = [a for n in QUICK + ["fig13-extension-*"] for a in ("--only", n)]
+    for workers in ("1", "2"):
+        assert main(["reproduce", "--out", str(tmp_path / workers), "--workers", workers, "--no-progress",
+                     *only]) == 0
+    names = sorted(p.relative_to(tmp_path / "1") for p in (tmp_path / "1").rglob("*.*")
+                   if p.suffix in (".png", ".csv"))
+    assert len([n for n in names if n.suffix == ".png"]) == 2 and len(names) == 6
+    for name in names:
+        assert (tmp_path / "2" / name).read_bytes() == (tmp_path / "1" / name).read_bytes(), name
+
+
 def test_reproduce_unknown_scenario_is_a_usage_error(tmp_path, capsys):
     assert main(["reproduce", "--out", str(tmp_path / "x"), "--only", "fig99-v1"]) == 2
     err = capsys.readouterr().err

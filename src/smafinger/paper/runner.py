@@ -1,7 +1,7 @@
 """``smafinger reproduce``: run the paper's scenarios, draw its figures, check its claims.
 
 :func:`reproduce` runs every scenario of :mod:`.scenarios` (or a selection) on a pool of
-worker processes, then writes into the output directory:
+worker processes, then writes into the output directory (the figures and CSVs on a pool too):
 
 - one PNG per figure (``fig07-cdf.png``, ``fig08-h0.png``, ...);
 - ``runs/NAME.csv``: the signals of every run every :data:`EVERY` output samples (10 ms),
@@ -133,20 +133,15 @@ def _simulate(tasks: list[tuple[str, RunSpec]], workers: int, progress,
             display.stop()
 
 
-def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
-    """``runs/NAME.csv`` (with its provenance sidecar) of every scenario run and
-    ``summary.json`` (numbers rounded, each run's provenance exact)."""
-    from ..export import add_signals
-    from ..files import Outputs
+def _write_summary(out_dir: Path, runs: dict[str, Run]) -> None:
+    """``summary.json``: per run its definition, summary and figure metrics (numbers rounded),
+    and its provenance (exact)."""
     from ..provenance import provenance
 
     summary: dict[str, Any] = {}
     for name, r in runs.items():
         entry: dict[str, Any] = json_ready({"scenario": r.scenario.definition()})
         if r.ok:
-            out = Outputs()
-            add_signals(out, r.result, out_dir / "runs" / f"{name}.csv", scenario=name, samples_every=EVERY)
-            out.commit()
             entry.update(json_ready(r.summary))
             entry["derived"] = json_ready(r.derived)
             entry["provenance"] = provenance(r.spec, scenario=name)
@@ -156,14 +151,40 @@ def _write_runs(out_dir: Path, runs: dict[str, Run]) -> None:
     write_json(out_dir / "summary.json", summary, digits=None)
 
 
-def _draw(out_dir: Path, runs: dict[str, Run]) -> list[Path]:
-    paths = []
+def _write_files(out_dir: Path, runs: dict[str, Run], workers: int) -> list[Path]:
+    """Every figure with a successful run (``KEY.png``) and every successful run's
+    ``runs/NAME.csv`` with its provenance sidecar, written on ``workers`` processes (figures
+    first, those with the most runs first: the pool stays busy to the end). Returns the
+    figures' paths, in figure order."""
+    from ..engine.batch import make_pool
+
+    figures = []
     for f in scn.FIGURES:
         sel = [runs[s.name] for s in f.scenarios if s.name in runs]
         if any(r.ok for r in sel):
-            f.plot(sel, f.title, out_dir / f"{f.key}.png")
-            paths.append(out_dir / f"{f.key}.png")
-    return paths
+            figures.append(("figure", f.key, sel, out_dir / f"{f.key}.png"))
+    csvs = [("csv", name, [r], out_dir / "runs" / f"{name}.csv") for name, r in runs.items() if r.ok]
+    jobs = sorted(figures, key=lambda job: -len(job[2])) + csvs
+    with make_pool(max(1, min(workers, len(jobs)))) as pool:
+        for _ in pool.map_tasks(_write_file, jobs):
+            pass
+    return [path for *_, path in figures]
+
+
+def _write_file(job: tuple[str, str, list[Run], Path]) -> None:
+    """Worker side: a figure, by its key (a figure's claims do not travel), from its runs; or
+    a run's CSV (every :data:`EVERY`-th sample) and its provenance sidecar."""
+    kind, key, sel, path = job
+    if kind == "figure":
+        f = scn.figure(key)
+        f.plot(sel, f.title, path)
+        return
+    from ..export import add_signals
+    from ..files import Outputs
+
+    out = Outputs()
+    add_signals(out, sel[0].result, path, scenario=key, samples_every=EVERY)
+    out.commit()
 
 
 def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
@@ -193,8 +214,8 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     for s in chosen:
         runs[s.name].scenario = s
     scen_runs = {n: runs[n] for n in names}
-    _write_runs(out_dir, scen_runs)
-    figures = _draw(out_dir, scen_runs)
+    _write_summary(out_dir, scen_runs)
+    figures = _write_files(out_dir, scen_runs, n_workers)
     rows = inv.table(runs) if investigate else None
     tables = study_tables(runs) if investigate else None
     if rows is not None:
