@@ -59,8 +59,8 @@ def test_parallel_results_bit_identical_to_single_runs():
 @pytest.mark.skipif(sys.platform != "linux", reason="a forkserver is a POSIX start method")
 def test_workers_fork_warm_from_the_forkserver():
     """Local workers fork from a forkserver that loaded the kernel (engine/forking.py): in each
-    worker it was loaded by neither the worker nor the client, but before either asked. A fresh
-    process, so that no forkserver is left from another test."""
+    worker it was loaded by neither the worker nor the client, but by the process it was forked
+    from. In a fresh process, so that no forkserver is left from another test."""
     pools.warm_up()  # the kernel in numba's disk cache
     code = ("import json, os\nfrom smafinger.engine import batch, pools\n"
             "pool = batch.LocalPool(2).start()\n"
