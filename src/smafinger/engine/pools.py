@@ -93,7 +93,8 @@ def is_warm() -> bool:
 
 
 def warmed_in(_=None) -> tuple[int, int | None]:
-    """(this process's id, the id of the process that loaded the kernel here: :data:`_WARMED_IN`)."""
+    """(this process's id, the id of the process that loaded the kernel here: :data:`_WARMED_IN`).
+    The argument is ignored, so that it can be mapped over tasks (:meth:`LocalPool.start`)."""
     return os.getpid(), _WARMED_IN
 
 
@@ -161,10 +162,6 @@ def _init_local_worker() -> None:
     warm_up()
 
 
-def _noop(_):
-    return os.getpid()
-
-
 # ---------------------------------------------------------------------------------------
 # pools
 # ---------------------------------------------------------------------------------------
@@ -216,7 +213,7 @@ class LocalPool(SerialPool):
 
     def start(self) -> "LocalPool":
         """Start and warm up every worker now (otherwise it happens with the first tasks)."""
-        list(self._ex.map(_noop, range(self.slots)))
+        list(self._ex.map(warmed_in, range(self.slots)))
         return self
 
     def map_tasks(self, fn, items):
