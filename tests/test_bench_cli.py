@@ -37,6 +37,21 @@ def test_quick_bench_writes_every_output(tmp_path):
     assert set(bw["controller"]) == set(QUICK_CONTROLLERS)
 
 
+def test_figures_drawn_on_two_workers_are_the_same_files(tmp_path):
+    """The runs and the figures on a pool of two (figures drawn in the workers, most runs first,
+    written here in task order): every file byte for byte what one process writes."""
+    outs = {}
+    for w in ("1", "2"):
+        outs[w] = tmp_path / f"w{w}"
+        r = runner.invoke(app, ["bench-controllers", "--out", str(outs[w]), "--quick", "--workers", w])
+        assert r.exit_code == 0, r.output
+    files = sorted(p.relative_to(outs["1"]) for p in outs["1"].rglob("*") if p.is_file())
+    assert sorted(p.relative_to(outs["2"]) for p in outs["2"].rglob("*") if p.is_file()) == files
+    assert sum(f.suffix == ".png" for f in files) == len(select_tasks(quick=True)) + 1  # + the bandwidth figure
+    for f in files:
+        assert (outs["1"] / f).read_bytes() == (outs["2"] / f).read_bytes(), f
+
+
 @pytest.mark.parametrize("args, names", [
     (["--controller", "pi"], "--controller 'pi'"),
     (["--strategy", "solo"], "--strategy 'solo'"),

@@ -135,8 +135,9 @@ def markdown(res: BenchResult, tasks: Sequence[Task]) -> str:
     return "\n".join(parts)
 
 
-def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bool = True) -> list[Path]:
-    """Write controllers.csv, bandwidth.csv, controllers.md, goals.json and the figures into ``out``."""
+def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bool = True, pool=None) -> list[Path]:
+    """Write controllers.csv, bandwidth.csv, controllers.md, goals.json and the figures into ``out``
+    (the figures drawn on ``pool`` if given: :func:`.figures.task_figures`)."""
     out = Path(out)
     text = markdown(res, tasks)
     g = goals(res.rows)
@@ -144,7 +145,7 @@ def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bo
     if figures:
         from .figures import task_figures
 
-        plots = task_figures(res, tasks)  # (name, PNG bytes), drawn before anything is written
+        plots = task_figures(res, tasks, pool)  # (name, PNG bytes), drawn before anything is written
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, frame in (("controllers.csv", res.rows), ("bandwidth.csv", res.bandwidth)):

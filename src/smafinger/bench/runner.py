@@ -56,9 +56,11 @@ def bench_specs(tasks: Sequence[Task], controllers: dict, strategies: Sequence[s
 
 def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
               strategies: Sequence[str] = STRATEGIES, workers: int | None = None,
-              report: Callable[[str], None] | None = None, controllers: dict | None = None) -> BenchResult:
+              report: Callable[[str], None] | None = None, controllers: dict | None = None,
+              pool=None) -> BenchResult:
     """Run every controller (``labels``, as :func:`~.presets.bench_controller` sets them, or
-    ``controllers``: (mechanism, label) -> object) under every strategy on every task."""
+    ``controllers``: (mechanism, label) -> object) under every strategy on every task; on
+    ``pool`` (:mod:`smafinger.engine.pools`) if given, else on ``workers`` processes."""
     say = report or (lambda msg: None)
     bad = [s for s in strategies if s not in STRATEGIES]
     if bad:
@@ -77,7 +79,7 @@ def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
     warm_kernels(spec for _, spec in keyed)
     say(f"{len(keyed)} runs: {len(tasks)} tasks, {len(labels)} controllers (tuned entries on their own mechanism "
         f"only), {len(strategies)} strategies")
-    outcomes = run_batch([spec for _, spec in keyed], workers=workers, reduce=record_of)
+    outcomes = run_batch([spec for _, spec in keyed], workers=workers, reduce=record_of, pool=pool)
     by_name = {(t.mechanism, t.name): t for t in tasks}
     rows, records = [], {}
     for (mech, task_name, label, strategy), rec in zip((k for k, _ in keyed), outcomes):

@@ -63,7 +63,7 @@ def bench_controllers(
     from ..bench.presets import BENCH_CONTROLLERS, QUICK_CONTROLLERS
     from ..bench.report import markdown, write_report
     from ..bench.runner import STRATEGIES, run_bench
-    from ..engine.batch import BatchError
+    from ..engine.batch import BatchError, make_pool
 
     bad = [c for c in controller if c not in BENCH_CONTROLLERS]
     if bad:
@@ -79,12 +79,13 @@ def bench_controllers(
     if not tasks:
         _fail("--mechanism/--task/--quick: no task left to run")
     labels = tuple(controller or (QUICK_CONTROLLERS if quick else BENCH_CONTROLLERS))
-    try:
-        res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers,
-                        report=_say)
-    except BatchError as exc:
-        _fail(str(exc), code=1)
-    write_report(res, tasks, out, figures=figures)
+    # one pool for the runs and the figures; its workers start while the controllers are made
+    with make_pool(workers) as pool:
+        try:
+            res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers, report=_say, pool=pool)
+        except BatchError as exc:
+            _fail(str(exc), code=1)
+        write_report(res, tasks, out, figures=figures, pool=pool)
     print(markdown(res, tasks))
     _say(f"written to {out}")
 
