@@ -151,6 +151,37 @@ def _write_summary(out_dir: Path, runs: dict[str, Run]) -> None:
     write_json(out_dir / "summary.json", summary, digits=None)
 
 
+@dataclass(frozen=True)
+class _FigureFile:
+    """A figure's PNG from its runs; the figure is looked up by its key in the worker (its
+    claims hold lambdas, which do not pickle)."""
+
+    key: str
+    runs: list[Run]
+    path: Path
+
+    def write(self) -> None:
+        f = scn.figure(self.key)
+        f.plot(self.runs, f.title, self.path)
+
+
+@dataclass(frozen=True)
+class _RunCsv:
+    """A run's CSV (every :data:`EVERY`-th sample) and its provenance sidecar."""
+
+    name: str
+    run: Run
+    path: Path
+
+    def write(self) -> None:
+        from ..export import add_signals
+        from ..files import Outputs
+
+        out = Outputs()
+        add_signals(out, self.run.result, self.path, scenario=self.name, samples_every=EVERY)
+        out.commit()
+
+
 def _write_files(out_dir: Path, runs: dict[str, Run], workers: int) -> list[Path]:
     """Every figure with a successful run (``KEY.png``) and every successful run's
     ``runs/NAME.csv`` with its provenance sidecar, written on ``workers`` processes (figures
@@ -162,29 +193,18 @@ def _write_files(out_dir: Path, runs: dict[str, Run], workers: int) -> list[Path
     for f in scn.FIGURES:
         sel = [runs[s.name] for s in f.scenarios if s.name in runs]
         if any(r.ok for r in sel):
-            figures.append(("figure", f.key, sel, out_dir / f"{f.key}.png"))
-    csvs = [("csv", name, [r], out_dir / "runs" / f"{name}.csv") for name, r in runs.items() if r.ok]
-    jobs = sorted(figures, key=lambda job: -len(job[2])) + csvs
+            figures.append(_FigureFile(f.key, sel, out_dir / f"{f.key}.png"))
+    csvs = [_RunCsv(name, r, out_dir / "runs" / f"{name}.csv") for name, r in runs.items() if r.ok]
+    jobs = sorted(figures, key=lambda job: -len(job.runs)) + csvs
     with make_pool(max(1, min(workers, len(jobs)))) as pool:
         for _ in pool.map_tasks(_write_file, jobs):
             pass
-    return [path for *_, path in figures]
+    return [job.path for job in figures]
 
 
-def _write_file(job: tuple[str, str, list[Run], Path]) -> None:
-    """Worker side: a figure, by its key (a figure's claims do not travel), from its runs; or
-    a run's CSV (every :data:`EVERY`-th sample) and its provenance sidecar."""
-    kind, key, sel, path = job
-    if kind == "figure":
-        f = scn.figure(key)
-        f.plot(sel, f.title, path)
-        return
-    from ..export import add_signals
-    from ..files import Outputs
-
-    out = Outputs()
-    add_signals(out, sel[0].result, path, scenario=key, samples_every=EVERY)
-    out.commit()
+def _write_file(job: _FigureFile | _RunCsv) -> None:
+    """Worker side of :func:`_write_files`: one file (and a CSV's sidecar)."""
+    job.write()
 
 
 def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
