@@ -13,7 +13,9 @@
       60 s simulated, K_P varied) as a sweep on every core: wall time, client peak memory;
       at the scenario's numerics (rk4, 1 ms, exact PWM) and at the long step (exponential,
       5 ms, averaged PWM: 0.012 deg RMS, 0.11 deg max from rk4 at 0.1 ms on this scenario).
-      Goal: <= 5 s and < 1 GB on 2 cores.
+      Goal: <= 5 s and < 1 GB on 2 cores. Beside it, one worker's work per run at the long
+      step, measured alone in this process, and the time that many runs take at that rate on
+      these cores if they did not slow each other down (a bound no pool can beat).
    b. 100 runs of 20 s at 1 ms returning results: full ``SimulationResult`` objects
       (``run_batch``) against :class:`~smafinger.engine.batch.Compact` (all signals, float32)
       and against streaming them with ``iter_batch`` (each written away as it comes).
@@ -233,6 +235,25 @@ def _child(case: str, n: int) -> dict:
     return json.loads(r.stdout.strip().splitlines()[-1])
 
 
+def _serial_per_run_s(n: int = 40) -> float:
+    """Seconds a run of the long-step full-cycle sweep takes in one process (point built, run,
+    row made and saved): a worker's work per run with no other process on the cores. Timed
+    from the first chunk's end to the last's, so the sweep's fixed costs (check pass, table
+    written) are left out."""
+    from smafinger.analysis.sweep import parse_spec, run_sweep
+
+    spec = parse_spec({"base": {"scenario": "fig15-cooperative-v1", "method": "exponential", "dt_s": 0.005,
+                                "pwm": "averaged"},
+                       "vary": {"K_P_per_rad": {"start": 2000.0, "stop": 4000.0, "num": n}}})
+    batch.warm_up()
+    marks: list[tuple[int, float]] = []
+    with tempfile.TemporaryDirectory() as d:
+        run_sweep(spec, Path(d) / "serial.parquet", workers=1, chunk_size=n // 4,
+                  on_progress=lambda done, total: marks.append((done, time.perf_counter())))
+    (d0, t0), (d1, t1) = marks[0], marks[-1]
+    return (t1 - t0) / (d1 - d0)
+
+
 def bench_lean(quick: bool) -> dict:
     n_cycle = 200 if quick else 1000
     print(f"\n[2a] {n_cycle} full-cycle runs (Fig. 15 co-operative, 60 s simulated) as a sweep on "
@@ -245,6 +266,12 @@ def bench_lean(quick: bool) -> dict:
         print(f"    {label}: wall {cyc['wall_s']:.1f} s ({1e3 * per_run:.1f} ms per run, pool start and check pass "
               f"included); client peak {cyc['peak_MB']:.0f} MB; failed {cyc['failed']}; client "
               f"{cyc['client_ms_per_run']:.3f} ms/run in the loop  (goal: 1,000 in <= 5 s, < 1 GB)")
+    one = _serial_per_run_s()
+    cores = batch.available_cores()
+    print(f"    the long step, one worker's work alone (a sweep of 40 runs in this process): {1e3 * one:.1f} ms a run; "
+          f"{n_cycle} runs on {cores} cores at that rate take >= {n_cycle * one / cores:.1f} s even with no "
+          f"contention between the cores")
+    out["serial_s_per_run"] = one
     print("\n[2b] 100 runs of 20 s at 1 ms, results returned (peak memory of the client)")
     out["cycle"] = out["sweep"]
     for case, label in (("full", "run_batch, full SimulationResults"), ("compact", "run_batch, Compact() float32"),
