@@ -56,6 +56,18 @@ def test_parallel_results_bit_identical_to_single_runs():
         assert _summary(a) == _summary(b)
 
 
+@pytest.mark.parametrize("workers", [1, 2])
+def test_progress_counts_every_outcome_once(workers):
+    """``on_progress(done, total)``: once per run as its outcome arrives, done counting 1..total
+    whatever order the chunks finish in, a failed run counted too."""
+    specs = _specs()
+    calls = []
+    out = run_batch(specs, workers=workers, chunk_size=2, reduce=_boom, errors="return",
+                    on_progress=lambda done, total: calls.append((done, total)))
+    assert sum(isinstance(v, RuntimeError) for v in out) == 1  # the euler run's reduce failed
+    assert calls == [(k, len(specs)) for k in range(1, len(specs) + 1)]
+
+
 @pytest.mark.skipif(sys.platform != "linux", reason="a forkserver is a POSIX start method")
 def test_workers_fork_warm_from_the_forkserver():
     """Local workers fork from a forkserver that loaded the kernel (engine/forking.py): in each

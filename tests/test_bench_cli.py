@@ -52,6 +52,31 @@ def test_figures_drawn_on_two_workers_are_the_same_files(tmp_path):
         assert (outs["1"] / f).read_bytes() == (outs["2"] / f).read_bytes(), f
 
 
+def test_progress_counts_the_runs_then_the_figures(tmp_path, monkeypatch):
+    """--progress: the runs, then the figures, counted to the end (plain lines, as in a log)."""
+    import io
+
+    from rich.console import Console
+
+    import smafinger.cli.bench as cli_bench
+    from smafinger.progress import Display
+
+    buf = io.StringIO()
+    monkeypatch.setattr(cli_bench, "progress_display",
+                        lambda flag: Display("lines" if flag else "off", Console(file=buf, width=200), 1e-9))
+    r = runner.invoke(app, ["bench-controllers", "--out", str(tmp_path / "b"), "--quick", "--workers", "1",
+                            "--progress"])
+    assert r.exit_code == 0, r.output
+    lines = buf.getvalue().splitlines()
+    tasks = select_tasks(quick=True)
+    n_runs, n_figs = len(tasks) * len(QUICK_CONTROLLERS) * 2, len(tasks) + 1
+    runs = [ln for ln in lines if ln.startswith("bench-controllers: ")]
+    figs = [ln for ln in lines if ln.startswith("figures: ")]
+    assert runs[-1].startswith(f"bench-controllers: {n_runs}/{n_runs} runs (100%)"), runs
+    assert figs[-1].startswith(f"figures: {n_figs}/{n_figs} figures (100%)"), figs
+    assert lines.index(runs[-1]) < lines.index(figs[0])
+
+
 @pytest.mark.parametrize("args, names", [
     (["--controller", "pi"], "--controller 'pi'"),
     (["--strategy", "solo"], "--strategy 'solo'"),

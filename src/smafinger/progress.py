@@ -13,6 +13,7 @@ One display for every command (simulate, reproduce, sweep, identify):
 from __future__ import annotations
 
 import time
+from typing import Callable
 
 MODES = ("bar", "lines", "off")
 
@@ -125,6 +126,18 @@ class Display:
             task._id = bar.add_task(label, total=total, completed=done, counts=task.counts(),
                                     note=", ".join(p for p in (note, suffix) if p))
         return task
+
+    def counter(self, label: str, unit: str = "") -> Callable[[int, int], None]:
+        """An ``on_progress(done, total)`` callback counting on a task of this display, the task
+        made at the first call (when the total is known)."""
+        made: list[Task] = []
+
+        def update(done: int, total: int) -> None:
+            if not made:
+                made.append(self.task(label, total, unit))
+            made[0].update(completed=done)
+
+        return update
 
     def _ensure_bar(self):
         if self._bar is None:

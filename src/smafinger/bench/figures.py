@@ -10,7 +10,7 @@ figure of the full bench took 20 s in one process.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 import pandas as pd
@@ -154,13 +154,19 @@ def draw(indexed_job: tuple[int, TaskFigure | BandwidthFigure]) -> tuple[int, st
     return (i, *job.draw())
 
 
-def task_figures(res: BenchResult, tasks: Sequence[Task], pool=None) -> list[tuple[str, bytes]]:
+def task_figures(res: BenchResult, tasks: Sequence[Task], pool=None,
+                 on_progress: Callable[[int, int], None] | None = None) -> list[tuple[str, bytes]]:
     """(name, PNG bytes) of every task's figure and of each mechanism's sine gains, in that order;
-    drawn on ``pool`` (:mod:`smafinger.engine.pools`) if given, else here."""
+    drawn on ``pool`` (:mod:`smafinger.engine.pools`) if given, else here.
+    ``on_progress(done, total)``: after each figure."""
     jobs = figure_jobs(res, tasks)
     if pool is None or pool.slots == 1:
-        return [job.draw() for job in jobs]
-    # the figures with the most runs first: the pool stays busy to the end
-    order = sorted(enumerate(jobs), key=lambda ij: -ij[1].runs)
-    drawn = {i: (name, png_bytes) for i, name, png_bytes in pool.map_tasks(draw, order)}
+        outcomes = map(draw, enumerate(jobs))
+    else:  # the figures with the most runs first: the pool stays busy to the end
+        outcomes = pool.map_tasks(draw, sorted(enumerate(jobs), key=lambda ij: -ij[1].runs))
+    drawn = {}
+    for i, name, png_bytes in outcomes:
+        drawn[i] = (name, png_bytes)
+        if on_progress is not None:
+            on_progress(len(drawn), len(jobs))
     return [drawn[i] for i in range(len(jobs))]

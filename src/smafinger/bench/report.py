@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import pandas as pd
 
@@ -135,9 +135,11 @@ def markdown(res: BenchResult, tasks: Sequence[Task]) -> str:
     return "\n".join(parts)
 
 
-def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bool = True, pool=None) -> list[Path]:
+def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bool = True, pool=None,
+                 on_progress: Callable[[int, int], None] | None = None) -> list[Path]:
     """Write controllers.csv, bandwidth.csv, controllers.md, goals.json and the figures into ``out``
-    (the figures drawn on ``pool`` if given: :func:`.figures.task_figures`)."""
+    (the figures drawn on ``pool`` if given, ``on_progress(done, total)`` after each:
+    :func:`.figures.task_figures`)."""
     out = Path(out)
     text = markdown(res, tasks)
     g = goals(res.rows)
@@ -145,7 +147,7 @@ def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bo
     if figures:
         from .figures import task_figures
 
-        plots = task_figures(res, tasks, pool)  # (name, PNG bytes), drawn before anything is written
+        plots = task_figures(res, tasks, pool, on_progress)  # (name, PNG bytes), drawn before anything is written
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, frame in (("controllers.csv", res.rows), ("bandwidth.csv", res.bandwidth)):

@@ -57,10 +57,11 @@ def bench_specs(tasks: Sequence[Task], controllers: dict, strategies: Sequence[s
 def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
               strategies: Sequence[str] = STRATEGIES, workers: int | None = None,
               report: Callable[[str], None] | None = None, controllers: dict | None = None,
-              pool=None) -> BenchResult:
+              pool=None, on_progress: Callable[[int, int], None] | None = None) -> BenchResult:
     """Run every controller (``labels``, as :func:`~.presets.bench_controller` sets them, or
     ``controllers``: (mechanism, label) -> object) under every strategy on every task; on
-    ``pool`` (:mod:`smafinger.engine.pools`) if given, else on ``workers`` processes."""
+    ``pool`` (:mod:`smafinger.engine.pools`) if given, else on ``workers`` processes.
+    ``on_progress(done, total)``: as the runs finish (:func:`~smafinger.engine.batch.run_batch`)."""
     say = report or (lambda msg: None)
     bad = [s for s in strategies if s not in STRATEGIES]
     if bad:
@@ -79,7 +80,8 @@ def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
     warm_kernels(spec for _, spec in keyed)
     say(f"{len(keyed)} runs: {len(tasks)} tasks, {len(labels)} controllers (tuned entries on their own mechanism "
         f"only), {len(strategies)} strategies")
-    outcomes = run_batch([spec for _, spec in keyed], workers=workers, reduce=record_of, pool=pool)
+    outcomes = run_batch([spec for _, spec in keyed], workers=workers, reduce=record_of, pool=pool,
+                         on_progress=on_progress)
     by_name = {(t.mechanism, t.name): t for t in tasks}
     rows, records = [], {}
     for (mech, task_name, label, strategy), rec in zip((k for k, _ in keyed), outcomes):

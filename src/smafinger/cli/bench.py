@@ -17,6 +17,8 @@ from typing import List, Optional
 
 import typer
 
+from .common import progress_display, progress_option
+
 MECHANISMS = ("joint", "linear-bias-spring")
 
 
@@ -53,6 +55,7 @@ def bench_controllers(
     figures: bool = typer.Option(True, "--figures/--no-figures", help="draw a figure per task"),
     quick: bool = typer.Option(False, "--quick", help="a smoke subset: a move per mechanism, the fastest sine, "
                                                       "the paper's PID and sliding mode (unless --controller)"),
+    progress: Optional[bool] = progress_option("progress bars (runs, then figures)"),
 ):
     """Run every controller x strategy on the bench tasks; write the table, the goals and the figures.
 
@@ -80,12 +83,13 @@ def bench_controllers(
         _fail("--mechanism/--task/--quick: no task left to run")
     labels = tuple(controller or (QUICK_CONTROLLERS if quick else BENCH_CONTROLLERS))
     # one pool for the runs and the figures; its workers start while the controllers are made
-    with make_pool(workers) as pool:
+    with progress_display(progress) as display, make_pool(workers) as pool:
         try:
-            res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers, report=_say, pool=pool)
+            res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers, report=_say, pool=pool,
+                            on_progress=display.counter("bench-controllers", "runs"))
         except BatchError as exc:
             _fail(str(exc), code=1)
-        write_report(res, tasks, out, figures=figures, pool=pool)
+        write_report(res, tasks, out, figures=figures, pool=pool, on_progress=display.counter("figures", "figures"))
     print(markdown(res, tasks))
     _say(f"written to {out}")
 

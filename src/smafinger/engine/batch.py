@@ -207,7 +207,7 @@ def iter_batch(runs: Iterable, *, workers: int | None = None, scheduler=None, re
 def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, scheduler=None,
               reduce: Callable | None = None, chunk_size: int | None = None,
               errors: str = "raise", pool=None, connect_timeout_s: float = CONNECT_TIMEOUT_S,
-              record: str = "all") -> list:
+              record: str = "all", on_progress: Callable[[int, int], None] | None = None) -> list:
     """Run many simulations in parallel; the results in input order.
 
     Parameters
@@ -236,6 +236,9 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
         The signals each run records: every one, or only those its metrics read (the results
         then have only those; :func:`~smafinger.engine.run.run_spec`). ``"metrics"`` writes
         about a third as much: for a ``reduce`` that needs no other signal.
+    on_progress : callable, optional
+        Called as ``on_progress(done, total)`` after each run's outcome arrives (they arrive a
+        task, a chunk of runs, at a time).
 
     All results are held in the returned list: for large batches use :func:`iter_batch`
     (bounded memory) or a ``reduce``.
@@ -247,12 +250,14 @@ def run_batch(runs: Iterable[RunSpec | dict], *, workers: int | None = None, sch
         return []
     out: list[Any] = [None] * len(specs)
     failed: list[tuple[int, Exception]] = []
-    for i, ok, value in iter_batch(specs, workers=workers, scheduler=scheduler, reduce=reduce,
-                                   chunk_size=chunk_size, pool=pool, connect_timeout_s=connect_timeout_s,
-                                   record=record):
+    outcomes = iter_batch(specs, workers=workers, scheduler=scheduler, reduce=reduce, chunk_size=chunk_size,
+                          pool=pool, connect_timeout_s=connect_timeout_s, record=record)
+    for done, (i, ok, value) in enumerate(outcomes, start=1):
         out[i] = value
         if not ok:
             failed.append((i, value))
+        if on_progress is not None:
+            on_progress(done, len(specs))
     if failed and errors == "raise":
         i, exc = min(failed, key=lambda x: x[0])
         raise BatchError(f"{len(failed)} of {len(specs)} runs failed; first: run {i}: "
