@@ -33,6 +33,7 @@ against compiling first.
 Usage::
 
     PYTHONPATH=src python benchmarks/bench_speed.py [--repeat 7] [--ref-dt 1e-6] [--cold] [--legacy-src PATH]
+                                                    [--only process]
 
 Goals (issue 11): full cycle <= 2 ms engine loop at <= 0.05 deg RMS and <= 0.3 deg max error;
 ``--help`` <= 0.3 s; cached ``simulate`` process <= 1 s; first result <= 10 s.
@@ -232,12 +233,46 @@ def bench_authors() -> None:
 
 
 def _process_s(code: str, env: dict | None = None, repeat: int = 3) -> float:
+    """Best of ``repeat`` whole processes running ``code``. Python may write its bytecode
+    (``PYTHONDONTWRITEBYTECODE`` is dropped): an installed package has it, so a process that
+    compiles every module from source would not be what users run."""
+    env = {k: v for k, v in (os.environ if env is None else env).items() if k != "PYTHONDONTWRITEBYTECODE"}
     best = float("inf")
     for _ in range(repeat):
         t0 = time.perf_counter()
         subprocess.run([sys.executable, "-c", code], check=True, env=env, capture_output=True)
         best = min(best, time.perf_counter() - t0)
     return best
+
+
+#: numba's own start: a one-line function, cached, called once in a fresh process
+_FLOOR_MODULE = """import numba
+
+
+@numba.njit(cache=True, error_model="numpy")
+def one(x):
+    return x + 1.0
+
+
+one(1.0)
+"""
+
+
+def _numba_floor_s(env: dict) -> tuple[float, float]:
+    """The least a process that calls a cached numba function takes here (import numba, and
+    its compiler's start, which a cached load needs: its registries import scipy.linalg to check
+    for BLAS): as it is, and ending with :func:`gc.freeze` as the console script does
+    (``smafinger.cli._console``). Best of 3 each after a first process has filled the cache."""
+    with tempfile.TemporaryDirectory() as tmp:
+        Path(tmp, "numba_floor.py").write_text(_FLOOR_MODULE)
+        env = dict(env, PYTHONPATH=tmp, NUMBA_CACHE_DIR=str(Path(tmp, "cache")))
+        _process_s("import numba_floor", env, repeat=1)
+        return _process_s("import numba_floor", env), _process_s("import numba_floor, gc; gc.freeze()", env)
+
+
+#: the cached full cycle as the ``smafinger simulate`` command (the console script's own exit)
+_CLI_RUN = ("import sys\nsys.argv = ['smafinger', 'simulate', '--profile', '0:-25,reach:-55,reach:-40', "
+            "'--t-end', '45', '--no-progress']\nfrom smafinger.cli import _console\n_console()")
 
 
 def bench_process(cold: bool) -> None:
@@ -248,9 +283,17 @@ def bench_process(cold: bool) -> None:
                         "try:\n    _console()\nexcept SystemExit:\n    pass", env)
     import_s = _process_s("import smafinger", env)
     cached_s = _process_s(run, dict(env, SMAFINGER_ENGINE="compiled"))
+    cli_s = _process_s(_CLI_RUN, dict(env, SMAFINGER_ENGINE="compiled"))
+    floor_s, frozen_s = _numba_floor_s(env)
     print("\n== process times (best of 3)")
     print(f"   smafinger --help             : {help_s:6.2f} s   (goal <= 0.3 s; 'import smafinger' alone {import_s:.2f} s)")
-    print(f"   cached simulate, full cycle  : {cached_s:6.2f} s   (goal <= 1 s)")
+    print(f"   cached simulate, full cycle  : {cached_s:6.2f} s   (goal <= 1 s; the Python API, python -c)")
+    print(f"   ... smafinger simulate       : {cli_s:6.2f} s   (the command: the console script, which freezes "
+          f"the collector before it ends; RATIO API/command {cached_s / cli_s:.2f}x)")
+    print(f"   ... numba's floor            : {floor_s:6.2f} s   (a cached one-line numba function, whole process; "
+          f"{frozen_s:.2f} s ending as the command does)")
+    print(f"   ... RATIO to the floor       : API {cached_s / floor_s:.2f}x ({cached_s - floor_s:+.2f} s), "
+          f"command {cli_s / frozen_s:.2f}x ({cli_s - frozen_s:+.2f} s)")
     if cold:
         bench_first_result(run, env)
 
@@ -284,8 +327,13 @@ def main() -> None:
     ap.add_argument("--cold", action="store_true", help="also time a run with an empty numba cache")
     ap.add_argument("--legacy-src", type=Path, default=None,
                     help="src folder of smafinger 0.1 (commit ff21ad0) to measure it side by side")
+    ap.add_argument("--only", choices=("process",), default=None,
+                    help="run only this section (process: the whole-process times)")
     args = ap.parse_args()
     print(f"bench_speed: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} (1 min)")
+    if args.only == "process":
+        bench_process(args.cold)
+        return
     results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
     bench_legacy(results[CASES[0][0]], args.legacy_src, args.repeat)
     bench_scipy(args.repeat)

@@ -11,7 +11,7 @@ import sys
 import pytest
 
 import smafinger
-from smafinger.cli import choices
+from smafinger.cli import choices, main
 
 #: modules that cost most of a second to import (numba's compiler, SciPy, pandas, plots, Dask,
 #: Arrow) and the package's own numerical layers; none is needed to print help
@@ -96,3 +96,36 @@ def test_fit_defaults_are_fit_settings():
 
     s = FitSettings()
     assert (choices.FIT_BUDGET, choices.FIT_MAX_NFEV, choices.FIT_SEED) == (s.budget, s.max_nfev, s.seed)
+
+
+def test_the_console_script_freezes_the_collector_before_it_ends(monkeypatch):
+    """``_console`` moves what is alive out of the collector's sight, then exits with the status."""
+    import gc
+
+    import smafinger.cli as cli
+
+    monkeypatch.setattr(cli, "main", lambda: 3)
+    gc.unfreeze()
+    try:
+        with pytest.raises(SystemExit) as exc:
+            cli._console()
+        assert exc.value.code == 3
+        assert gc.get_freeze_count() > 0
+    finally:
+        gc.unfreeze()
+
+
+def test_the_console_scripts_files_are_whole_after_it_ends(tmp_path):
+    """The process's end without the final collections loses no output: the signals and the
+    summary a ``python -m smafinger.cli`` process writes are those the same command writes here."""
+    args = ["simulate", "--profile", "0:-25", "--t-end", "1", "--no-progress"]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.run([sys.executable, "-m", "smafinger.cli", *args, "--out", str(tmp_path / "child.csv"),
+                           "--summary", str(tmp_path / "child.json")], env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert main([*args, "--out", str(tmp_path / "here.csv"), "--summary", str(tmp_path / "here.json")]) == 0
+    assert (tmp_path / "child.csv").read_bytes() == (tmp_path / "here.csv").read_bytes()
+    child, here = (json.loads((tmp_path / f"{n}.json").read_text()) for n in ("child", "here"))
+    child.pop("wall_s", None), here.pop("wall_s", None)
+    assert child == here
