@@ -257,45 +257,71 @@ def one(x):
 one(1.0)
 """
 
+#: the command line of the cached full cycle (``smafinger simulate``)
+_CLI_ARGV = "['smafinger', 'simulate', '--profile', '0:-25,reach:-55,reach:-40', '--t-end', '45', '--no-progress']"
 
-def _numba_floor_s(env: dict) -> tuple[float, float]:
-    """The least a process that calls a cached numba function takes here (import numba, and
-    its compiler's start, which a cached load needs: its registries import scipy.linalg to check
-    for BLAS): as it is, and ending with :func:`gc.freeze` as the console script does
-    (``smafinger.cli._console``). Best of 3 each after a first process has filled the cache."""
+
+def _process_kinds(env: dict, floor_dir: str) -> dict[str, tuple[str, dict]]:
+    """The processes timed side by side: (code for ``python -c``, environment) by name.
+
+    - ``api``: the cached full cycle through the Python API (``simulate(...)`` in ``python -c``);
+    - ``command``: the same as the ``smafinger simulate`` command, through the console script,
+      which freezes the collector before the process ends (``smafinger.cli._console``);
+    - ``command, no freeze``: the command run and ended as before that (``sys.exit(main())``);
+    - ``floor``: numba's own start, a cached one-line function (import numba, and its
+      compiler's start, which a cached load needs: its registries import scipy.linalg to check
+      for BLAS); ``floor, frozen``: the same ending as the command does.
+    """
+    compiled = dict(env, SMAFINGER_ENGINE="compiled")
+    floor = dict(env, PYTHONPATH=floor_dir, NUMBA_CACHE_DIR=str(Path(floor_dir, "cache")))
+    return {
+        "help": ("import sys; sys.argv = ['smafinger', '--help']\nfrom smafinger.cli import _console\n"
+                 "try:\n    _console()\nexcept SystemExit:\n    pass", env),
+        "import": ("import smafinger", env),
+        "api": ("from smafinger import simulate; simulate('paper2010', 'cooperative', "
+                "'0:-25,reach:-55,reach:-40', t_end_s=45.0)", compiled),
+        "command": (f"import sys\nsys.argv = {_CLI_ARGV}\nfrom smafinger.cli import _console\n_console()", compiled),
+        "command, no freeze": (f"import sys\nsys.argv = {_CLI_ARGV}\nfrom smafinger.cli import main\n"
+                               "sys.exit(main())", compiled),
+        "floor": ("import numba_floor", floor),
+        "floor, frozen": ("import numba_floor, gc; gc.freeze()", floor),
+    }
+
+
+def bench_process(cold: bool, rounds: int = 7) -> None:
+    """Whole-process times, every kind once per round in turn (load from elsewhere hits each
+    alike): medians over the rounds, and ratios as the median of the rounds' own ratios."""
+    env = dict(os.environ, PYTHONPATH=str(SRC))
     with tempfile.TemporaryDirectory() as tmp:
         Path(tmp, "numba_floor.py").write_text(_FLOOR_MODULE)
-        env = dict(env, PYTHONPATH=tmp, NUMBA_CACHE_DIR=str(Path(tmp, "cache")))
-        _process_s("import numba_floor", env, repeat=1)
-        return _process_s("import numba_floor", env), _process_s("import numba_floor, gc; gc.freeze()", env)
+        kinds = _process_kinds(env, tmp)
+        for code, kenv in kinds.values():  # caches and bytecode filled, not counted
+            _process_s(code, kenv, repeat=1)
+        times: dict[str, list[float]] = {k: [] for k in kinds}
+        for _ in range(rounds):
+            for k, (code, kenv) in kinds.items():
+                times[k].append(_process_s(code, kenv, repeat=1))
+    med = {k: statistics.median(v) for k, v in times.items()}
 
+    def ratio(a: str, b: str) -> float:
+        return statistics.median(x / y for x, y in zip(times[a], times[b]))
 
-#: the cached full cycle as the ``smafinger simulate`` command (the console script's own exit)
-_CLI_RUN = ("import sys\nsys.argv = ['smafinger', 'simulate', '--profile', '0:-25,reach:-55,reach:-40', "
-            "'--t-end', '45', '--no-progress']\nfrom smafinger.cli import _console\n_console()")
-
-
-def bench_process(cold: bool) -> None:
-    env = dict(os.environ, PYTHONPATH=str(SRC))
-    run = ("from smafinger import simulate; simulate('paper2010', 'cooperative', '0:-25,reach:-55,reach:-40', "
-           "t_end_s=45.0)")
-    help_s = _process_s("import sys; sys.argv = ['smafinger', '--help']\nfrom smafinger.cli import _console\n"
-                        "try:\n    _console()\nexcept SystemExit:\n    pass", env)
-    import_s = _process_s("import smafinger", env)
-    cached_s = _process_s(run, dict(env, SMAFINGER_ENGINE="compiled"))
-    cli_s = _process_s(_CLI_RUN, dict(env, SMAFINGER_ENGINE="compiled"))
-    floor_s, frozen_s = _numba_floor_s(env)
-    print("\n== process times (best of 3)")
-    print(f"   smafinger --help             : {help_s:6.2f} s   (goal <= 0.3 s; 'import smafinger' alone {import_s:.2f} s)")
-    print(f"   cached simulate, full cycle  : {cached_s:6.2f} s   (goal <= 1 s; the Python API, python -c)")
-    print(f"   ... smafinger simulate       : {cli_s:6.2f} s   (the command: the console script, which freezes "
-          f"the collector before it ends; RATIO API/command {cached_s / cli_s:.2f}x)")
-    print(f"   ... numba's floor            : {floor_s:6.2f} s   (a cached one-line numba function, whole process; "
-          f"{frozen_s:.2f} s ending as the command does)")
-    print(f"   ... RATIO to the floor       : API {cached_s / floor_s:.2f}x ({cached_s - floor_s:+.2f} s), "
-          f"command {cli_s / frozen_s:.2f}x ({cli_s - frozen_s:+.2f} s)")
+    print(f"\n== process times (medians of {rounds} rounds, each kind once per round in turn; ratios: "
+          "median of the rounds' ratios)")
+    print(f"   smafinger --help             : {med['help']:6.2f} s   (goal <= 0.3 s; 'import smafinger' alone "
+          f"{med['import']:.2f} s)")
+    print(f"   cached simulate, full cycle  : {med['api']:6.2f} s   (goal <= 1 s; the Python API, python -c)")
+    print(f"   ... smafinger simulate       : {med['command']:6.2f} s   (the command; RATIO command/API "
+          f"{ratio('command', 'api'):.2f}x)")
+    print(f"   ... without the freeze       : {med['command, no freeze']:6.2f} s   (the command ended by "
+          f"sys.exit(main()), as before 3816f20; RATIO with/without {ratio('command', 'command, no freeze'):.2f}x)")
+    print(f"   numba's floor                : {med['floor']:6.2f} s   (a cached one-line numba function, whole "
+          f"process; {med['floor, frozen']:.2f} s ending as the command does)")
+    print(f"   ... RATIO to the floor       : API {ratio('api', 'floor'):.2f}x "
+          f"({med['api'] - med['floor']:+.2f} s), command {ratio('command', 'floor, frozen'):.2f}x "
+          f"({med['command'] - med['floor, frozen']:+.2f} s)")
     if cold:
-        bench_first_result(run, env)
+        bench_first_result(kinds["api"][0], env)
 
 
 def bench_first_result(run: str, env: dict) -> None:
@@ -332,13 +358,13 @@ def main() -> None:
     args = ap.parse_args()
     print(f"bench_speed: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} (1 min)")
     if args.only == "process":
-        bench_process(args.cold)
+        bench_process(args.cold, args.repeat)
         return
     results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
     bench_legacy(results[CASES[0][0]], args.legacy_src, args.repeat)
     bench_scipy(args.repeat)
     bench_authors()
-    bench_process(args.cold)
+    bench_process(args.cold, args.repeat)
 
 
 if __name__ == "__main__":
