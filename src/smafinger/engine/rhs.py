@@ -35,10 +35,10 @@ class Geometry(NamedTuple):
 def geometry(model, q):
     """:class:`Geometry` at coordinate q (Eqs. 3-6 and the external load of Eq. 1b)."""
     w = model.wires
+    c, s = math.cos(q), math.sin(q)  # once for every wire (kinematics.route)
     routes = filled(w, WireGeometry(0.0, 0.0, 0.0))
     for i in range(len(w)):
-        routes = set_item(routes, i, route(w[i].route, q))
-    c = math.cos(q)
+        routes = set_item(routes, i, route(w[i].route, q, c, s))
     return Geometry(routes, c, external_load(model.dynamics.load, q, c))
 
 

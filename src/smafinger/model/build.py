@@ -45,10 +45,13 @@ def _wire(p: ParameterSet, **derived) -> Wire:
 # --------------------------------------------------------------------------------------------
 def tendon_routes(p: JointParameters) -> tuple[TendonRoute, TendonRoute]:
     """(upper, lower) tendon routes from the MODEL-NOTES dimensions (Eq. 3)."""
+    # B at theta = 0: r (cos alpha0, sin alpha0) with r and alpha0 as MODEL-NOTES gives them (that is
+    # (a3, +-a1) up to rounding); the switch follows the upper B against C_U's height a1
     r = math.hypot(p.a1_m, p.a3_m)
-    a0u, a0l = math.atan2(p.a1_m, p.a3_m), math.atan2(-p.a1_m, p.a3_m)
-    upper = TendonRoute(r, a0u, -p.a5_m, p.a1_m, p.a2_m, p.a1_m, a0u, p.a1_m, False)
-    lower = TendonRoute(r, a0l, -p.a4_m, -p.a1_m, p.a2_m, -p.a1_m, a0u, p.a1_m, True)
+    bu = (r * math.cos(math.atan2(p.a1_m, p.a3_m)), r * math.sin(math.atan2(p.a1_m, p.a3_m)))
+    bl = (r * math.cos(math.atan2(-p.a1_m, p.a3_m)), r * math.sin(math.atan2(-p.a1_m, p.a3_m)))
+    upper = TendonRoute(*bu, -p.a5_m, p.a1_m, p.a2_m, p.a1_m, *bu, p.a1_m, False)
+    lower = TendonRoute(*bl, -p.a4_m, -p.a1_m, p.a2_m, -p.a1_m, *bu, p.a1_m, True)
     return upper, lower
 
 

@@ -2,7 +2,7 @@
 
 Joint (:class:`TendonRoute`). Frame O-XY at the MCP joint centre; theta from the X axis,
 positive = extension. Point B on the phalanx (Eq. 3): B = r (cos(theta + alpha0),
-sin(theta + alpha0)). Fixed points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1);
+sin(theta + alpha0)), computed as B0 = r (cos alpha0, sin alpha0) turned by theta. Fixed points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1);
 lower C_L = (-a4, -a1), D_L = (+a2, -a1). Configuration switch: while Y_B(upper) >= Y_C(upper)
 (finger up or level) the upper tendon runs straight C_U -> B_U (Configuration I, Eq. 4) and
 the lower wraps over D_L (Configuration II, Eq. 5); otherwise the upper wraps over D_U and the
@@ -28,16 +28,22 @@ from ..jit import njit
 
 
 class TendonRoute(NamedTuple):
-    """One tendon of the joint (Eqs. 3-5); the switch is the upper B passing C_U's height."""
+    """One tendon of the joint (Eqs. 3-5); the switch is the upper B passing C_U's height.
 
-    r_m: float  #: |OB|
-    alpha0_rad: float  #: angle of B at theta = 0
+    B and the switch's point are held at theta = 0 and turned by theta (Eq. 3 as a rotation:
+    r (cos(theta + alpha0), sin(theta + alpha0)) is B0 = r (cos alpha0, sin alpha0) turned by
+    theta), so that every wire's geometry takes the one cosine and sine of theta.
+    """
+
+    B0_x_m: float  #: B at theta = 0: r cos(alpha0)
+    B0_y_m: float  #: r sin(alpha0)
     C_x_m: float
     C_y_m: float
     D_x_m: float
     D_y_m: float
-    switch_alpha0_rad: float  #: the configuration switch: "up" while r sin(theta + this) >= switch_y_m
-    switch_y_m: float
+    switch_x_m: float  #: the configuration switch's point (the upper B) at theta = 0
+    switch_y0_m: float
+    switch_y_m: float  #: "up" while that point, turned by theta, is at this height or above
     wrapped_when_up: bool  #: the lower tendon wraps over D while the finger is up, the upper while down
 
 
@@ -56,18 +62,10 @@ class DirectPull(NamedTuple):
 
 
 @njit(cache=True, forceinline=True)
-def tendon(theta, r, alpha0, xc, yc, xd, yd, wrapped):
-    """:class:`WireGeometry` of one tendon: path length [m], d(path)/d(theta) [m/rad], moment arm b [m].
-
-    Eqs. (3), (4a)/(5a) without the reference subtraction, (4b)/(5b).
-    """
-    a = theta + alpha0
-    return tendon_at(r * math.cos(a), r * math.sin(a), xc, yc, xd, yd, wrapped)
-
-
-@njit(cache=True, forceinline=True)
 def tendon_at(xb, yb, xc, yc, xd, yd, wrapped):
-    """:func:`tendon` with B = (xb, yb) given (Eq. 3)."""
+    """:class:`WireGeometry` of one tendon with B = (xb, yb) (Eq. 3): path length [m],
+    d(path)/d(theta) [m/rad], moment arm b [m]; Eqs. (4a)/(5a) without the reference
+    subtraction, (4b)/(5b)."""
     if wrapped:
         xp = xd
         yp = yd
@@ -84,28 +82,27 @@ def tendon_at(xb, yb, xc, yc, xd, yd, wrapped):
 
 
 @njit(cache=True, forceinline=True)
-def tendon_route(rt, theta):
-    """(path, dpath/dtheta, arm) of a joint tendon, with its Configuration I/II switch."""
-    a = theta + rt.alpha0_rad
-    sin_a = math.sin(a)
-    if rt.switch_alpha0_rad == rt.alpha0_rad:  # the upper tendon: its own B decides (one sine)
-        sin_switch = sin_a
-    else:
-        sin_switch = math.sin(theta + rt.switch_alpha0_rad)
-    up = rt.r_m * sin_switch >= rt.switch_y_m
+def tendon_route(rt, theta, cos_theta, sin_theta):
+    """(path, dpath/dtheta, arm) of a joint tendon, with its Configuration I/II switch;
+    ``cos_theta``, ``sin_theta``: those of theta [rad] (B = B0 turned by theta, Eq. 3)."""
+    xb = rt.B0_x_m * cos_theta - rt.B0_y_m * sin_theta
+    yb = rt.B0_x_m * sin_theta + rt.B0_y_m * cos_theta
+    up = rt.switch_x_m * sin_theta + rt.switch_y0_m * cos_theta >= rt.switch_y_m
     wrapped = up if rt.wrapped_when_up else not up
-    return tendon_at(rt.r_m * math.cos(a), rt.r_m * sin_a, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
+    return tendon_at(xb, yb, rt.C_x_m, rt.C_y_m, rt.D_x_m, rt.D_y_m, wrapped)
 
 
 @njit(cache=True, forceinline=True)
-def direct_pull(rt, x):
-    """(path, dpath/dx, arm) of a wire pulling a slider: path = -x from the start."""
+def direct_pull(rt, x, cos_x, sin_x):
+    """(path, dpath/dx, arm) of a wire pulling a slider: path = -x from the start (the cosine
+    and sine are not used: every route takes them)."""
     return WireGeometry(rt.dpath_dq * x, rt.dpath_dq, 1.0)
 
 
-def route(rt, q):
-    """The :class:`WireGeometry` of a wire at coordinate q; dispatched on the route's type."""
-    return _ROUTES[type(rt)](rt, q)
+def route(rt, q, cos_q, sin_q):
+    """The :class:`WireGeometry` of a wire at coordinate q (``cos_q``, ``sin_q``: its cosine
+    and sine, computed once for all the wires); dispatched on the route's type."""
+    return _ROUTES[type(rt)](rt, q, cos_q, sin_q)
 
 
 #: each route record and its geometry function
@@ -113,14 +110,14 @@ _ROUTES = {TendonRoute: tendon_route, DirectPull: direct_pull}
 
 
 @overload(route)
-def _route(rt, q):
+def _route(rt, q, cos_q, sin_q):
     if isinstance(rt, types.BaseNamedTuple) and rt.instance_class in _ROUTES:
         f = _ROUTES[rt.instance_class]
-        return lambda rt, q: f(rt, q)
+        return lambda rt, q, cos_q, sin_q: f(rt, q, cos_q, sin_q)
     return None
 
 
 @njit(cache=True)
 def wire_route(rt, q):
-    """:func:`route`, also callable from Python (compiled once per route type)."""
-    return route(rt, q)
+    """:func:`route` at q, also callable from Python (compiled once per route type)."""
+    return route(rt, q, math.cos(q), math.sin(q))
