@@ -38,6 +38,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import NamedTuple
 
 import math
 
@@ -108,6 +109,31 @@ def phi12(z):
     return e / z, (e - z) / (z * z)
 
 
+class Damping(NamedTuple):
+    """The exponential integrator's phi1 and phi2 of z = -c h (:func:`phi12`), kept from step
+    to step while z is the same: c = C_DF / I changes only where the damping switches between
+    heating and cooling, and h only at events, so most steps reuse them (one ``expm1`` less)."""
+
+    z: float
+    phi1: float
+    phi2: float
+
+
+#: no step yet: z is NaN, which no z equals
+NO_DAMPING = Damping(math.nan, 1.0, 0.5)
+
+
+@njit(cache=True, forceinline=True)
+def damping_over(c, h, prev):
+    """:class:`Damping` of the damping c [1/s] over a step h [s]: ``prev`` if its z = -c h is
+    this one's (the same bits), else phi12(-c h)."""
+    z = -c * h
+    if z == prev.z:
+        return prev
+    p1, p2 = phi12(z)
+    return Damping(z, p1, p2)
+
+
 @njit(cache=True, forceinline=True)
 def load_stiffness(model, y, inputs, k1):
     """kappa = -d(q'')/dq at the state's v and wire states [1/s^2]: the mechanism's stiffness
@@ -125,14 +151,15 @@ def load_stiffness(model, y, inputs, k1):
 
 
 @njit(cache=True, forceinline=True)
-def _damped_mechanism(method, y, k1, h, c, kappa):
+def _damped_mechanism(method, y, k1, h, c, kappa, damp):
     """(q, v) after h with the viscous damping c = C_DF / I treated implicitly or exactly.
 
     v' = a - c v with a = k1.v + c v held over the step. ``semi-implicit``: v1 = v + h k1.v /
     (1 + c h), q1 = q + h v1; with a stiffness kappa > 0 (a = a0 - kappa (q - q0)),
     v1 = v + h (k1.v - kappa h v) / (1 + c h + kappa h^2). ``exponential``: v1 = v +
-    h phi1(-c h) k1.v and q1 = q + h q' + h^2 phi2(-c h) k1.v (exact for a constant a). A stuck
-    mechanism has q' = v' = 0: it stays.
+    h phi1(-c h) k1.v and q1 = q + h q' + h^2 phi2(-c h) k1.v (exact for a constant a), with
+    phi1, phi2 from ``damp`` (:func:`damping_over` of c and h). A stuck mechanism has
+    q' = v' = 0: it stays.
     """
     if method == Method.SEMI_IMPLICIT:
         if kappa > 0.0:  # the stiffness implicit too: v1 (1 + c h + kappa h^2) = v (1 + c h) + h q''
@@ -140,8 +167,7 @@ def _damped_mechanism(method, y, k1, h, c, kappa):
         else:
             dv = h * k1.v / (1.0 + c * h)
         return y.q + h * (k1.q + dv), y.v + dv
-    p1, p2 = phi12(-c * h)
-    return y.q + h * k1.q + h * h * p2 * k1.v, y.v + h * p1 * k1.v
+    return y.q + h * k1.q + h * h * damp.phi2 * k1.v, y.v + h * damp.phi1 * k1.v
 
 
 @njit(cache=True, forceinline=True)
@@ -156,10 +182,13 @@ def _wires_at_mean_rate(wires, aux, extra):
 
 
 @njit(cache=True, forceinline=True)
-def step(method, model, y, h, inputs, k1, aux, geom, stages):
-    """y advanced by h (see the module docstring for the methods). Returns (y, evaluations, inputs).
+def step(method, model, y, h, inputs, k1, aux, geom, stages, damp):
+    """y advanced by h (see the module docstring for the methods). Returns (y, evaluations,
+    inputs, damp).
 
     ``aux``: the algebraic quantities at y, with k1 (the wires' rates' growth with v).
+    ``damp``: the last step's :class:`Damping` (:data:`NO_DAMPING` at first); ``exponential``
+    returns this step's, the other methods return it as given.
 
     RK4 as a loop over its three later stages (one right-hand-side call site, so that it is
     compiled once): the weighted sum accumulates k1 + 2 k2 + 2 k3 + k4 in that order.
@@ -170,13 +199,18 @@ def step(method, model, y, h, inputs, k1, aux, geom, stages):
     returned ``inputs`` carry their globals after the last stage (otherwise ``inputs`` as given).
     """
     if method == Method.EULER:
-        return axpy(y, h, k1), 0, inputs
+        return axpy(y, h, k1), 0, inputs, damp
     if method == Method.SEMI_IMPLICIT or method == Method.EXPONENTIAL:
         ye = axpy(y, h, k1)
-        kappa = load_stiffness(model, y, inputs, k1) if method == Method.SEMI_IMPLICIT else 0.0
-        q, v = _damped_mechanism(method, y, k1, h, inputs.viscous / model.dynamics.inertia, kappa)
+        c = inputs.viscous / model.dynamics.inertia
+        kappa = 0.0
+        if method == Method.SEMI_IMPLICIT:
+            kappa = load_stiffness(model, y, inputs, k1)
+        else:
+            damp = damping_over(c, h, damp)
+        q, v = _damped_mechanism(method, y, k1, h, c, kappa, damp)
         wires = _wires_at_mean_rate(ye.wires, aux, (q - y.q) - h * k1.q)
-        return State(q, v, ye.error_integral, wires), 0, inputs
+        return State(q, v, ye.error_integral, wires), 0, inputs, damp
     half = 0.5 * h
     acc = k1
     k = k1
@@ -195,4 +229,4 @@ def step(method, model, y, h, inputs, k1, aux, geom, stages):
         if method == Method.AUTHORS_ODE4:
             inputs = with_field(inputs, "wires", commit_calls(model, yk, inp, aux).wires)
         acc = axpy(acc, 1.0 if stage == 2 else 2.0, k)
-    return axpy(y, h / 6.0, acc), 3, inputs
+    return axpy(y, h / 6.0, acc), 3, inputs, damp

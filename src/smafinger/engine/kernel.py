@@ -30,7 +30,7 @@ from .pwm import PwmModel, sampled_phases
 from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, confirm_tick, track_reach
 from .signals import record_sample
-from .integrators import Method
+from .integrators import NO_DAMPING, Method
 from .substep import (STACK_CAPACITY, Counters, authors_calls_inputs, decide, initial_commands, initial_inputs,
                       initial_state, integrate)
 from .tuples import filled, with_field
@@ -211,6 +211,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
     locate = run.pwm == PwmModel.AVERAGED  #: long steps: reach events located inside a step
     t, prog_i, next_out, out_i = 0, 0, 0, 0
     first, stuck, v_prev = True, False, 0.0
+    damp = NO_DAMPING  #: the exponential integrator's phi1, phi2, kept while -c h repeats
     next_event = _next_event(s, run, segs, prog, prog_i)
     while True:
         if _segment_due(s, t, segs.start) or s.waiting:
@@ -252,8 +253,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             if out_i < n_out and (next_out < a or (final and next_out == a)):
                 out_i, next_out = _flush(mo, wo, out_i, next_out, run, model.wires, a, final, prev, now)
             prev = now
-            y, counters, t_fail, inputs = integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters, cmds,
-                                                    s, phase_mid, phase_end, memory.error)
+            y, counters, t_fail, inputs, damp = integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters,
+                                                          cmds, s, phase_mid, phase_end, memory.error, damp)
             if counters.status != 0:
                 return counters, y, t_fail
             a = b

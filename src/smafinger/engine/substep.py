@@ -267,22 +267,23 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
 
 @njit(cache=True, forceinline=True)
 def integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters, cmds, s, phase_mid, phase_end,
-              error_major):
+              error_major, damp):
     """Advance the state over [a, b] (ticks) and apply the post-step constraints (``k1``, ``aux``:
     the derivative and the algebraic quantities at the start).
 
     With the authors' solver the later stages read the controller and the PWM at their own
     states and phases (``phase_mid``, ``phase_end``; ``cmds``: the tick's commands, ``s``: the
     schedule, ``error_major``: q_F - q at the major step; see :func:`.authors.stage_inputs`). Returns (y, counters,
-    t_fail_s, inputs); ``counters.status`` is 1 if the state is no longer finite; ``inputs`` carry the
-    authors' martensite globals after the step (:func:`.integrators.step`).
+    t_fail_s, inputs, damp); ``counters.status`` is 1 if the state is no longer finite; ``inputs`` carry the
+    authors' martensite globals after the step; ``damp``: the exponential integrator's factors, kept
+    for the next step (:func:`.integrators.step`).
     """
     if b > a:
         stages = Stages(run, cmds, s.enabled, s.q_target, _low(model, run), phase_mid, phase_end, error_major)
-        y, n, inputs = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, aux, geom, stages)
+        y, n, inputs, damp = step(run.method, model, y, (b - a) * run.tick_s, inputs, k1, aux, geom, stages, damp)
         y = _xi_caught_up(model, y, inputs)
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
-        return y, with_field(counters, "status", 1), b * run.tick_s, inputs
-    return y, counters, 0.0, inputs
+        return y, with_field(counters, "status", 1), b * run.tick_s, inputs, damp
+    return y, counters, 0.0, inputs, damp
