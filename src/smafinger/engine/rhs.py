@@ -35,11 +35,11 @@ class Geometry(NamedTuple):
 def geometry(model, q):
     """:class:`Geometry` at coordinate q (Eqs. 3-6 and the external load of Eq. 1b)."""
     w = model.wires
-    c, s = math.cos(q), math.sin(q)  # once for every wire (kinematics.route)
+    cos_q, sin_q = math.cos(q), math.sin(q)  # once for every wire (kinematics.route)
     routes = filled(w, WireGeometry(0.0, 0.0, 0.0))
     for i in range(len(w)):
-        routes = set_item(routes, i, route(w[i].route, q, c, s))
-    return Geometry(routes, c, external_load(model.dynamics.load, q, c))
+        routes = set_item(routes, i, route(w[i].route, q, cos_q, sin_q))
+    return Geometry(routes, cos_q, external_load(model.dynamics.load, q, cos_q))
 
 
 @njit(cache=True, forceinline=True)

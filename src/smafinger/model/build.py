@@ -48,8 +48,8 @@ def tendon_routes(p: JointParameters) -> tuple[TendonRoute, TendonRoute]:
     # B at theta = 0: r (cos alpha0, sin alpha0) with r and alpha0 as MODEL-NOTES gives them (that is
     # (a3, +-a1) up to rounding); the switch follows the upper B against C_U's height a1
     r = math.hypot(p.a1_m, p.a3_m)
-    bu = (r * math.cos(math.atan2(p.a1_m, p.a3_m)), r * math.sin(math.atan2(p.a1_m, p.a3_m)))
-    bl = (r * math.cos(math.atan2(-p.a1_m, p.a3_m)), r * math.sin(math.atan2(-p.a1_m, p.a3_m)))
+    a0u, a0l = math.atan2(p.a1_m, p.a3_m), math.atan2(-p.a1_m, p.a3_m)
+    bu, bl = (r * math.cos(a0u), r * math.sin(a0u)), (r * math.cos(a0l), r * math.sin(a0l))
     upper = TendonRoute(*bu, -p.a5_m, p.a1_m, p.a2_m, p.a1_m, *bu, p.a1_m, False)
     lower = TendonRoute(*bl, -p.a4_m, -p.a1_m, p.a2_m, -p.a1_m, *bu, p.a1_m, True)
     return upper, lower

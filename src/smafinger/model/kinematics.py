@@ -2,8 +2,9 @@
 
 Joint (:class:`TendonRoute`). Frame O-XY at the MCP joint centre; theta from the X axis,
 positive = extension. Point B on the phalanx (Eq. 3): B = r (cos(theta + alpha0),
-sin(theta + alpha0)), computed as B0 = r (cos alpha0, sin alpha0) turned by theta. Fixed points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1);
-lower C_L = (-a4, -a1), D_L = (+a2, -a1). Configuration switch: while Y_B(upper) >= Y_C(upper)
+sin(theta + alpha0)), computed as B0 = r (cos alpha0, sin alpha0) turned by theta. Fixed
+points (MODEL-NOTES): upper C_U = (-a5, +a1), D_U = (+a2, +a1); lower C_L = (-a4, -a1),
+D_L = (+a2, -a1). Configuration switch: while Y_B(upper) >= Y_C(upper)
 (finger up or level) the upper tendon runs straight C_U -> B_U (Configuration I, Eq. 4) and
 the lower wraps over D_L (Configuration II, Eq. 5); otherwise the upper wraps over D_U and the
 lower runs straight. The path length includes the fixed segment |C D| when wrapped, so that it
