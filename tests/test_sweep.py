@@ -626,3 +626,27 @@ def test_dashboard_link_is_printed():
 
     Progress(Console(file=buf), False, 10.0, "x").pool(Pool())
     assert buf.getvalue().strip() == "Dask dashboard: http://127.0.0.1:8787/status"
+
+
+def test_the_writer_libraries_are_imported_while_the_first_rows_are_awaited(tmp_path, monkeypatch):
+    """The run pass starts pyarrow's and pandas' import (sweep_store.preload_writer) once,
+    before it waits for any row, so the first part written does not wait for it."""
+    events = []
+    real_part = sw.write_part
+    monkeypatch.setattr(sw, "preload_writer", lambda: events.append("preload"))
+    monkeypatch.setattr(sw, "write_part", lambda *a, **k: (events.append("part"), real_part(*a, **k))[1])
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nsave_interval_s = 0\nchunk_size = 3\n"))
+    run_sweep(spec, tmp_path / "res.parquet", workers=1)
+    assert events == ["preload", "part", "part"]
+    events.clear()
+    run_sweep(spec, tmp_path / "res.parquet", workers=1)  # nothing left to run: nothing to write
+    assert events == []
+
+
+def test_preload_writer_imports_pandas_for_pyarrow_in_a_thread_the_process_waits_for():
+    code = ("import sys\nfrom smafinger.analysis.sweep_store import preload_writer\n"
+            "before = 'pandas' in sys.modules\nth = preload_writer()\nth.join()\n"
+            "print(before, th.daemon, 'pandas' in sys.modules, 'pyarrow.parquet' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env=dict(os.environ, PYTHONPATH=str(SRC)))
+    assert out.stdout.split() == ["False", "False", "True", "True"]

@@ -58,7 +58,7 @@ from .sweep_rows import (METRIC_COLUMNS, MOTION_THRESHOLD_DEG, TRACE_COLUMNS, ch
 from .sweep_size import SweepSize, SweepSizeError, check_size, max_t_end, sweep_size  # noqa: F401 (re-exported)
 from .sweep_spec import (DEFAULT_MAX_RUNS, RUN_ID_SCHEMA, Run, SweepSpec, SweepSpecError, Vary,  # noqa: F401
                          canonical_run, run_id)
-from .sweep_store import IdIndex, StoreError, clean_stale, parts_dir, traces_path, write_part
+from .sweep_store import IdIndex, StoreError, clean_stale, parts_dir, preload_writer, traces_path, write_part
 
 #: points per task of the check pass (a few ms of work each), and rows per part file at most
 CHECK_BLOCK = 1024
@@ -253,6 +253,7 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
             say.line(f"running {ran} runs on {backend}")
             size = chunk_size or spec.chunk_size or batch.auto_chunk_size(ran, pool.slots)
             fn = partial(_run_item, traces_interval_s=spec.traces_interval_s if traces else None, row=metrics_row)
+            preload_writer()  # pandas' import (pyarrow's) overlaps the wait for the first rows
             failed, client_s = _run_pass(spec, pool, fn, _run_items(template, points, checked.ids, todo, size),
                                          _Saver(pdir, spec.save_interval_s, traces), say, done0, total, on_progress)
     finally:
