@@ -650,3 +650,29 @@ def test_preload_writer_imports_pandas_for_pyarrow_in_a_thread_the_process_waits
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          env=dict(os.environ, PYTHONPATH=str(SRC)))
     assert out.stdout.split() == ["False", "False", "True", "True"]
+
+
+ABSURD = _spec('[vary]\nvoltage = ["0:8:0,1:0:0", "0:60:0,1:0:0"]\n', sweep='mode = "list"',
+               base='params = "paper2010-table2"\nstrategy = "open-loop"\nt_end_s = 2.0\n')
+
+
+def test_absurd_runs_are_flagged_in_their_warnings_column(tmp_path):
+    """A run the plausibility check flags (60 V on the paper's wire: about 680 degC) says so in
+    its row, with the run's own warnings; an ordinary run's column is empty; a rerun counts the
+    same; the command says how many, and a flagged run is not a failed one (exit status 0)."""
+    from smafinger.engine.run import run_spec
+
+    spec = _write(tmp_path, ABSURD)
+    out = tmp_path / "w.parquet"
+    rep = run_sweep(spec, out, workers=1)
+    df = pd.read_parquet(out)
+    assert (rep.failed_total, rep.flagged_total) == (0, 1) and (df["status"] == "ok").all()
+    assert df.loc[0, "warnings"] == ""
+    hot = run_spec(load_spec(spec).runs()[1].spec).metrics["warnings"]
+    assert hot and any("upper wire" in w and "austenite finish" in w for w in hot)
+    assert df.loc[1, "warnings"] == sw.WARNINGS_SEPARATOR.join(hot) and df.loc[1, "peak_T_upper_C"] > 600.0
+    assert run_sweep(spec, out, workers=1).flagged_total == 1  # resumed: read back from the table
+    r = _cli([str(spec), "--out", "c.parquet", "--workers", "1"], tmp_path)
+    assert r.exit_code == 0, r.output
+    assert "1 of 2 runs have plausibility warnings" in r.output
+    assert "plausibility warnings" not in _cli([str(_write(tmp_path, SMALL)), "--workers", "1"], tmp_path).output

@@ -53,8 +53,8 @@ from ..engine.run import RunSpec, SimulationError  # noqa: F401 (re-exported)
 from .sweep_merge import Finished, write_table, write_traces
 from .sweep_parse import load_spec, parse_spec
 from .sweep_progress import Progress
-from .sweep_rows import (METRIC_COLUMNS, MOTION_THRESHOLD_DEG, TRACE_COLUMNS, check_block, error_row,  # noqa: F401
-                         metrics_row, run_block)
+from .sweep_rows import (METRIC_COLUMNS, MOTION_THRESHOLD_DEG, TRACE_COLUMNS, WARNINGS_SEPARATOR,  # noqa: F401
+                         check_block, error_row, metrics_row, run_block)
 from .sweep_size import SweepSize, SweepSizeError, check_size, max_t_end, sweep_size  # noqa: F401 (re-exported)
 from .sweep_spec import (DEFAULT_MAX_RUNS, RUN_ID_SCHEMA, Run, SweepSpec, SweepSpecError, Vary,  # noqa: F401
                          canonical_run, run_id)
@@ -159,6 +159,8 @@ class SweepReport:
     backend: str
     #: failed runs in the whole table (this invocation's and resumed ones)
     failed_total: int = 0
+    #: runs in the whole table with plausibility warnings (their ``warnings`` column)
+    flagged_total: int = 0
     #: the client's own time in the run pass, per run that ran (s)
     client_s_per_run: float = math.nan
 
@@ -262,11 +264,12 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     finished = Finished(out, pdir, index, traces)
     if not finished.done.all():
         raise RuntimeError(f"internal error: {int((~finished.done).sum())} runs have no result after the sweep")
-    failed_total = finished.failed_count()
+    failed_total, flagged_total = finished.failed_count(), finished.flagged_count()
     _merge(spec, out, pdir, finished, points, checked, traces, template)
     return SweepReport(out=out, traces_out=traces_path(out) if traces else None, total=total,
                        resumed=done0, ran=ran, failed=failed, wall_s=time.perf_counter() - t_start,
-                       backend=backend, failed_total=failed_total, client_s_per_run=client_s)
+                       backend=backend, failed_total=failed_total, flagged_total=flagged_total,
+                       client_s_per_run=client_s)
 
 
 def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tuple[int, float]:

@@ -149,12 +149,21 @@ class Finished:
 
     def failed_count(self) -> int:
         """Runs of the sweep whose finished row says ``status = error``."""
+        return self._count("status", lambda status: status == "error")
+
+    def flagged_count(self) -> int:
+        """Runs of the sweep whose finished row has plausibility warnings (rows written before
+        the ``warnings`` column existed have none)."""
+        return self._count("warnings", lambda w: np.array([bool(x) for x in w], dtype=bool))
+
+    def _count(self, column: str, which) -> int:
+        """Finished rows for which ``which(values of column)`` is true (sources without it: none)."""
         n = 0
         for s, src in enumerate(self.sources):
             sel = np.flatnonzero(self.src == s)
-            if sel.size:
-                status = src.take(self.row[sel])["status"].to_numpy(zero_copy_only=False)
-                n += int(np.sum(status == "error"))
+            if sel.size and column in src.names:
+                values = src.take(self.row[sel])[column].to_numpy(zero_copy_only=False)
+                n += int(np.sum(which(values)))
                 src.release()
         return n
 

@@ -58,10 +58,14 @@ METRIC_COLUMNS = (
     "motion_start_s", "steps", "wall_s",
     # the numerics the run used (engine.numerics: a point's varied values can change its default)
     "run_method", "run_dt_s", "run_pwm",
+    # the run's plausibility warnings (smafinger.plausibility: physically absurd results), "; "-joined
+    "warnings",
 )
 INT_COLUMNS = ("interlock_violations", "steps")
 #: text columns (the others are numbers)
-STRING_COLUMNS = ("run_id", "status", "error", "run_method", "run_pwm")
+STRING_COLUMNS = ("run_id", "status", "error", "run_method", "run_pwm", "warnings")
+#: joins a run's plausibility warnings in its ``warnings`` column ("" when it has none)
+WARNINGS_SEPARATOR = "; "
 #: per-segment columns: target, start, reach time and overshoot (target and overshoot in every unit)
 SEGMENT_COLUMNS = (f"target_{UNITS[0]}", "start_s", "reached_s", f"overshoot_{UNITS[0]}",
                    *(f"{c}_{u}" for u in UNITS[1:] for c in ("target", "overshoot")))
@@ -89,6 +93,7 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         "motion_start_s": float(t[moved[0]]) if moved.size else math.nan,
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
         "run_method": result.spec.method, "run_dt_s": float(result.spec.dt_s), "run_pwm": result.spec.pwm,
+        "warnings": WARNINGS_SEPARATOR.join(s["warnings"]),
     })
     segs = {seg["index"]: seg for seg in s["segments"]}
     for i, seg_def in enumerate(result.spec.profile.segments):

@@ -80,6 +80,9 @@ def sweep(
     extra = "".join(f" and {p}" for p in (report.traces_out, mat) if p)
     typer.echo(f"wrote {report.out}{extra}: {report.total} runs ({report.resumed} already done, "
                f"{report.failed_total} failed) in {report.wall_s:.1f} s on {report.backend}")
+    if report.flagged_total:
+        print(f"smafinger: {report.flagged_total} of {report.total} runs have plausibility warnings (physically "
+              "absurd results: overheating, overstress or overstrain; see their warnings column)", file=sys.stderr)
     if report.failed_total:
         every = report.failed_total == report.total
         print(f"smafinger: {'every run' if every else f'{report.failed_total} of {report.total} runs'} failed "
