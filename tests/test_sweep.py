@@ -676,3 +676,36 @@ def test_absurd_runs_are_flagged_in_their_warnings_column(tmp_path):
     assert r.exit_code == 0, r.output
     assert "1 of 2 runs have plausibility warnings" in r.output
     assert "plausibility warnings" not in _cli([str(_write(tmp_path, SMALL)), "--workers", "1"], tmp_path).output
+
+
+@pytest.mark.parametrize("first_fails", [True, False])
+def test_a_part_that_opens_with_a_failed_run_keeps_the_other_runs_metrics(tmp_path, monkeypatch, first_fails):
+    """A failed run's row has no metrics. When it was the first row of a part file, the part took
+    its columns from that row alone (pyarrow's from_pylist), and every other run of the part
+    came out of the table with status ok and NaN metrics."""
+    spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nchunk_size = 6\n"))
+    ref = tmp_path / "ref.parquet"
+    run_sweep(spec, ref, workers=1)
+    failing = 0 if first_fails else 5
+    monkeypatch.setattr(sw, "metrics_row", _failing(lambda r: r.spec == load_spec(spec).runs()[failing].spec))
+    out = tmp_path / "res.parquet"
+    assert run_sweep(spec, out, workers=1).failed == 1
+    df, want = _frame(out), _frame(ref)
+    ok = df["status"] == "ok"
+    assert ok.sum() == 5 and df.loc[~ok, "point"].tolist() == [failing]
+    metrics = [c for c in want.columns if c not in ("status", "error") and want[c].dtype.kind == "f"]
+    assert metrics and df.loc[ok, "theta_max_deg"].notna().all()
+    pd.testing.assert_frame_equal(df.loc[ok, metrics], want.loc[ok, metrics])
+
+
+def test_a_part_keeps_the_segments_of_runs_with_more_segments_than_its_first(tmp_path):
+    """The same for a varied profile: a 2-segment run after a 1-segment one in the same part
+    lost its second segment's columns."""
+    spec = _write(tmp_path, _spec('[vary]\nprofile = ["0:-25", "0:-25,3:-55"]\n', sweep='mode = "list"',
+                                  base='params = "paper2010"\nstrategy = "cooperative"\nt_end_s = 6.0\n'))
+    run_sweep(spec, tmp_path / "res.parquet", workers=1)
+    df = _frame(tmp_path / "res.parquet")
+    assert np.isnan(df.loc[0, "seg1_target_deg"]) and df.loc[1, "seg1_target_deg"] == -55.0
+    assert df.loc[1, "seg1_start_s"] == pytest.approx(3.0)
+    alone = sw.metrics_row(__import__("smafinger").engine.run.run_spec(load_spec(spec).runs()[1].spec))
+    assert df.loc[1, "seg1_overshoot_deg"] == alone["seg1_overshoot_deg"]

@@ -84,6 +84,17 @@ def preload_writer() -> threading.Thread:
     return th
 
 
+def rows_table(rows: list[dict]):
+    """The rows as a table with a column for every key of any row (in order of first
+    appearance), null where a row has none. ``pyarrow.Table.from_pylist`` takes the columns of
+    the first row alone: a part opening with a failed run (a row with no metrics) lost every
+    other run's metrics."""
+    import pyarrow as pa
+
+    names = list(dict.fromkeys(k for r in rows for k in r))
+    return pa.table({k: [r.get(k) for r in rows] for k in names})
+
+
 def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
     """One part: ``part-<time>-<uid>.parquet`` (+ ``.traces.parquet``, written first), each durable."""
     import pyarrow as pa
@@ -96,7 +107,7 @@ def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
     if traces is not None:
         ttab = pa.table(traces)
         atomic_write(pdir / f"{stem}.traces.parquet", lambda tmp: pq.write_table(ttab, tmp), durable=True)
-    tab = pa.Table.from_pylist(rows)
+    tab = rows_table(rows)
     path = pdir / f"{stem}.parquet"
     atomic_write(path, lambda tmp: pq.write_table(tab, tmp), durable=True)
     return path
