@@ -709,3 +709,36 @@ def test_a_part_keeps_the_segments_of_runs_with_more_segments_than_its_first(tmp
     assert df.loc[1, "seg1_start_s"] == pytest.approx(3.0)
     alone = sw.metrics_row(__import__("smafinger").engine.run.run_spec(load_spec(spec).runs()[1].spec))
     assert df.loc[1, "seg1_overshoot_deg"] == alone["seg1_overshoot_deg"]
+
+
+def test_traces_survive_a_merge_stopped_between_its_two_files(tmp_path, monkeypatch):
+    """The merge writes OUT.traces, then OUT. Stopped between the two after a spec that renumbers
+    the runs, the next run read the new traces by the old table's point numbers, skipped the row
+    groups holding some runs, and lost their samples for good (they counted as finished)."""
+    from smafinger.analysis import sweep_merge
+
+    monkeypatch.setattr(sweep_merge, "TRACE_BLOCK_SAMPLES", 21)  # a row group per run, as in a large sweep
+    base = {"params": "paper2010-table2", "strategy": "open-loop", "voltage": "0:8:0,1:0:0", "t_end_s": 2.0}
+
+    def spec(values):
+        return parse_spec({"base": base, "vary": {"C_DF_heating_Nms": values}})
+
+    out = tmp_path / "r.parquet"
+    run_sweep(spec([0.02, 0.03, 0.04, 0.05]), out, workers=1, traces=True)
+    renumbered = spec([0.01, 0.05, 0.04, 0.03, 0.02])
+    real = sw.write_table
+
+    def stopped(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sw, "write_table", stopped)
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(renumbered, out, workers=1, traces=True)
+    monkeypatch.setattr(sw, "write_table", real)
+    rep = run_sweep(renumbered, out, workers=1, traces=True)
+    assert rep.ran == 0  # the new point ran before the stop, and its part was kept
+    tr = pd.read_parquet(sw.traces_path(out))
+    per_point = tr.groupby("point").size().reindex(range(5), fill_value=0)
+    assert (per_point == 21).all(), per_point.to_dict()
+    df = pd.read_parquet(out)
+    assert set(tr["run_id"]) == set(df["run_id"])

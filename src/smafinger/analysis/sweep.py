@@ -41,6 +41,7 @@ from __future__ import annotations
 import json
 import math
 import time
+import uuid
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -312,12 +313,14 @@ def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Che
                  and (not traces or meta.get("traces")))
     if not unchanged:
         varied = [v.name for v in spec.vary]
+        merge = uuid.uuid4().hex  # in both files: the traces' points are the table's (sweep_merge.same_merge)
         if traces:
             samples = max(1, round(max_t_end(spec) / spec.traces_interval_s) + 1)
             write_traces(traces_path(out), finished, samples,
-                         {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s, "version": __version__})
+                         {"varied": [], "of": out.name, "interval_s": spec.traces_interval_s, "version": __version__,
+                          "merge": merge})
         write_table(out, finished, points, varied, checked.n_segments,
-                    {"varied": varied, "spec": canonical, "version": __version__, "traces": traces,
+                    {"varied": varied, "spec": canonical, "version": __version__, "traces": traces, "merge": merge,
                      "motion_threshold_deg": MOTION_THRESHOLD_DEG, "provenance": sweep_provenance(template)})
     if pdir.is_dir():
         for f in pdir.iterdir():

@@ -34,7 +34,9 @@ class Source:
         self._bounds = np.cumsum([0] + [md.row_group(i).num_rows for i in range(md.num_row_groups)])
         self._rows: tuple[tuple, object] | None = None
         self._traces: tuple[tuple, object] | None = None
-        self.own_points: np.ndarray | None = None  # OUT: its rows' points (in its own sweep)
+        #: OUT: its rows' points (in its own sweep), to skip the traces' row groups of other
+        #: points; None (read every row group) unless its traces are of the same merge
+        self.own_points: np.ndarray | None = None
 
     def read_columns(self, names: list[str]):
         import pyarrow.parquet as pq
@@ -91,6 +93,20 @@ def _groups_with(pf, points: np.ndarray) -> tuple:
     return tuple(out)
 
 
+def same_merge(out_meta: dict, traces: Path) -> bool:
+    """Whether ``OUT.traces`` was written by the merge that wrote ``OUT`` (both carry its
+    ``merge`` id): only then are its ``point`` numbers OUT's. A merge stopped between the two
+    files (the traces are written first) leaves traces numbered by the new spec beside the old
+    table; skipping row groups by those numbers lost runs' samples for good (they counted as
+    finished). Read by run id alone, every row group, the same file gives every run's samples.
+    Tables written before the id existed have none: read whole."""
+    try:
+        merge = (read_meta(traces) or {}).get("merge")
+    except Exception:  # noqa: BLE001 - unreadable: not the same
+        return False
+    return merge is not None and merge == out_meta.get("merge")
+
+
 class Finished:
     """For every point: the newest finished row of its run (source, row), from ``OUT`` and
     the parts. With ``traces``, a run finished without its trace does not count (a failed
@@ -114,7 +130,7 @@ class Finished:
             tp = traces_path(out)
             has = bool(self.out_meta.get("traces")) and tp.exists()
             src = Source(out, tp if has else None, is_out=True)
-            if "point" in src.names:
+            if has and "point" in src.names and same_merge(self.out_meta, tp):
                 src.own_points = src.read_columns(["point"])["point"].to_numpy()
             self._add(src)
         if pdir.is_dir():
