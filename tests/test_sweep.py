@@ -742,3 +742,20 @@ def test_traces_survive_a_merge_stopped_between_its_two_files(tmp_path, monkeypa
     assert (per_point == 21).all(), per_point.to_dict()
     df = pd.read_parquet(out)
     assert set(tr["run_id"]) == set(df["run_id"])
+
+
+@pytest.mark.parametrize("output_s, traces_s", [(0.04, 0.1), (0.5, 0.1)])
+def test_traces_interval_must_be_a_multiple_of_the_runs_output_interval(tmp_path, output_s, traces_s):
+    """Traces keep every k-th output sample: at 0.04 s samples and a 0.1 s interval they were
+    0.08 s apart in a file that said 0.1 s. Refused by the check pass, naming both, before
+    anything is written (and so is an interval shorter than the samples')."""
+    base = (f'params = "paper2010-table2"\nstrategy = "open-loop"\nvoltage = "0:8:0,1:0:0"\nt_end_s = 2.0\n'
+            f'output_interval_s = {output_s}\n')
+    spec = _write(tmp_path, _spec("[vary]\nC_DF_heating_Nms = [0.02, 0.03]\n", sweep=f"traces_interval_s = {traces_s}",
+                                  base=base))
+    with pytest.raises(SweepSpecError, match=rf"point 0 .*traces_interval_s = {traces_s:g} s is not a whole "
+                                             rf"multiple of the run's output_interval_s = {output_s:g} s"):
+        run_sweep(spec, tmp_path / "r.parquet", workers=1, traces=True)
+    assert list(tmp_path.iterdir()) == [spec]
+    rep = run_sweep(spec, tmp_path / "r.parquet", workers=1)  # without traces the interval does not matter
+    assert rep.failed == 0

@@ -88,22 +88,22 @@ def _check_item(item):
 class Checked:
     ids: np.ndarray
     n_segments: int
-    max_output_interval_s: float
 
 
-def check_points(spec: SweepSpec, template, points, pool) -> Checked:
-    """Every point's run id, validated in ``pool``'s workers; refuses a bad or repeated point."""
+def check_points(spec: SweepSpec, template, points, pool, traces_interval_s: float | None = None) -> Checked:
+    """Every point's run id, validated in ``pool``'s workers (with ``traces_interval_s``, its
+    traces' sampling too); refuses a bad or repeated point."""
     n = points.n
     ids = np.zeros(n, dtype="S16")
     block = max(16, min(CHECK_BLOCK, math.ceil(n / (4 * pool.slots))))
-    items = ((template, a, cols) for a, cols in points.blocks(block))
-    n_seg, out_s = 0, 0.0
+    items = ((template, a, cols, traces_interval_s) for a, cols in points.blocks(block))
+    n_seg = 0
     for res in pool.map_tasks(_check_item, items):
         if res.error is not None:
             point, values, msg = res.error
             raise spec.point_error(point, values, msg)
         ids[res.start:res.start + len(res.ids)] = res.ids
-        n_seg, out_s = max(n_seg, res.n_segments), max(out_s, res.max_output_interval_s)
+        n_seg = max(n_seg, res.n_segments)
     order = np.argsort(ids, kind="stable")
     same = np.flatnonzero(ids[order][1:] == ids[order][:-1])
     if same.size:
@@ -112,7 +112,7 @@ def check_points(spec: SweepSpec, template, points, pool) -> Checked:
         first = int(order[same[np.argmin(second)]])
         vals = points.block(j, j + 1)
         raise spec.duplicate_error(first, j, {k: v[0] for k, v in vals.items()})
-    return Checked(ids, n_seg, out_s)
+    return Checked(ids, n_seg)
 
 
 # ---------------------------------------------------------------------------------------
@@ -234,10 +234,8 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
         if scheduler is not None or total > CHECK_HERE_MAX:
             pool = batch.make_pool(workers, scheduler, connect_timeout_s)
             say.pool(pool)
-        checked = check_points(spec, template, points, pool or batch.SerialPool())
-        if traces and checked.max_output_interval_s > spec.traces_interval_s * (1 + 1e-9):
-            raise SweepSpecError(f"{spec.source}: [sweep] traces_interval_s = {spec.traces_interval_s} is shorter "
-                                 "than the runs' output_interval_s")
+        checked = check_points(spec, template, points, pool or batch.SerialPool(),
+                               spec.traces_interval_s if traces else None)
         clean_stale(out)
         index = IdIndex(checked.ids)
         try:

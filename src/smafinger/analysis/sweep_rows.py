@@ -104,8 +104,7 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         row[f"seg{i}_reached_s"] = math.nan if reached is None else float(reached)
         row[f"seg{i}_overshoot_{unit}"] = float(seg[f"overshoot_{unit}"]) if seg else math.nan
     if traces_interval_s:
-        step = max(1, round(traces_interval_s / result.spec.output_interval_s))
-        row["_trace"] = trace(result, step)
+        row["_trace"] = trace(result, trace_step(traces_interval_s, result.spec.output_interval_s))
     return row
 
 
@@ -143,33 +142,46 @@ def _values_at(columns: dict[str, list], k: int) -> dict:
 @dataclass(frozen=True)
 class CheckedBlock:
     """What checking a block of points found: each run's id (bytes, ``S16``), the most
-    segments and the longest output interval of its runs, and the first bad point."""
+    segments of its runs, and the first bad point."""
 
     start: int
     ids: np.ndarray
     n_segments: int
-    max_output_interval_s: float
     error: tuple[int, dict, str] | None = None
 
 
-def check_block(template: SweepTemplate, start: int, columns: dict[str, list]) -> CheckedBlock:
-    """Build and validate the spec of every point of a block, and compute its run id.
+def check_block(template: SweepTemplate, start: int, columns: dict[str, list],
+                traces_interval_s: float | None = None) -> CheckedBlock:
+    """Build and validate the spec of every point of a block, and compute its run id; with
+    ``traces_interval_s``, check that each run can be traced at it (:func:`trace_step`).
 
     Stops at the first bad point: ``error = (point, values, message)``.
     """
     n = len(next(iter(columns.values()))) if columns else 0
     ids = np.zeros(n, dtype="S16")
-    n_seg, out_s = 0, 0.0
+    n_seg = 0
     for k in range(n):
         values = _values_at(columns, k)
         try:
             spec = template.build(values)
+            if traces_interval_s:
+                trace_step(traces_interval_s, spec.output_interval_s)
         except SPEC_ERRORS as exc:
-            return CheckedBlock(start, ids[:k], n_seg, out_s, (start + k, values, str(exc)))
+            return CheckedBlock(start, ids[:k], n_seg, (start + k, values, str(exc)))
         ids[k] = run_id(spec).encode()
         n_seg = max(n_seg, len(spec.profile.segments))
-        out_s = max(out_s, spec.output_interval_s)
-    return CheckedBlock(start, ids, n_seg, out_s)
+    return CheckedBlock(start, ids, n_seg)
+
+
+def trace_step(traces_interval_s: float, output_interval_s: float) -> int:
+    """Every how many output samples a run's trace keeps one. ``traces_interval_s`` must be a
+    whole multiple of the run's ``output_interval_s``, so that the traces are sampled at the
+    interval their file states (ValueError otherwise)."""
+    step = round(traces_interval_s / output_interval_s)
+    if step < 1 or abs(step * output_interval_s - traces_interval_s) > 1e-9 * traces_interval_s:
+        raise ValueError(f"[sweep] traces_interval_s = {traces_interval_s:g} s is not a whole multiple of the run's "
+                         f"output_interval_s = {output_interval_s:g} s")
+    return step
 
 
 # ---------------------------------------------------------------------------------------
