@@ -18,6 +18,7 @@ from smafinger.analysis import sweep as sw
 from smafinger.analysis.sweep import (SweepInterrupted, SweepSizeError, SweepSpecError, load_spec, parse_spec,
                                      run_sweep)
 from smafinger.analysis.sweep_spec import canonical_run
+from smafinger.analysis.sweep_store import traces_interval
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG8 = ROOT / "examples" / "sweep-fig8.toml"
@@ -759,3 +760,24 @@ def test_traces_interval_must_be_a_multiple_of_the_runs_output_interval(tmp_path
     assert list(tmp_path.iterdir()) == [spec]
     rep = run_sweep(spec, tmp_path / "r.parquet", workers=1)  # without traces the interval does not matter
     assert rep.failed == 0
+
+
+def test_traces_taken_at_another_interval_are_taken_again(tmp_path):
+    """A rerun asking for another traces interval kept the runs' old traces (the interval is not
+    part of a run's id) under a file that stated the new one (found by review: 21 samples a run
+    at 0.1 s in a file saying 0.5 s). Traces files state their interval, and a run whose trace was
+    taken at another counts as not finished."""
+    base = 'params = "paper2010-table2"\nstrategy = "open-loop"\nvoltage = "0:8:0,1:0:0"\nt_end_s = 2.0\n'
+    out = tmp_path / "r.parquet"
+    first = _write(tmp_path, _spec("[vary]\nC_DF_heating_Nms = [0.02, 0.03]\n", sweep="traces_interval_s = 0.1",
+                                   base=base), "a.toml")
+    run_sweep(first, out, workers=1, traces=True)
+    second = _write(tmp_path, _spec("[vary]\nC_DF_heating_Nms = [0.02, 0.03, 0.04]\n", sweep="traces_interval_s = 0.5",
+                                    base=base), "b.toml")
+    rep = run_sweep(second, out, workers=1, traces=True)
+    assert (rep.ran, rep.resumed) == (3, 0)
+    tr = pd.read_parquet(sw.traces_path(out))
+    assert tr.groupby("point").size().to_dict() == {0: 5, 1: 5, 2: 5}
+    assert np.allclose(np.diff(tr[tr["point"] == 0]["t_s"]), 0.5)
+    assert traces_interval(sw.traces_path(out)) == 0.5
+    assert run_sweep(second, out, workers=1, traces=True).ran == 0  # the same interval again: all finished

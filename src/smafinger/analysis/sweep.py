@@ -169,8 +169,9 @@ class SweepReport:
 class _Saver:
     """Buffers finished rows and writes them as a part at least every ``interval_s``."""
 
-    def __init__(self, pdir: Path, interval_s: float, traces: bool):
-        self.pdir, self.interval_s, self.traces = pdir, interval_s, traces
+    def __init__(self, pdir: Path, interval_s: float, traces_interval_s: float | None):
+        self.pdir, self.interval_s, self.traces_interval_s = pdir, interval_s, traces_interval_s
+        self.traces = traces_interval_s is not None
         self.rows: list[dict] = []
         self.trs: list[dict] = []
         self.last = time.monotonic()
@@ -187,7 +188,8 @@ class _Saver:
             tr = None
             if self.traces:
                 tr = {c: np.concatenate([t[c] for t in self.trs]) for c in self.trs[0]} if self.trs else None
-            write_part(self.pdir, self.rows, tr if tr is not None else (_empty_traces() if self.traces else None))
+            write_part(self.pdir, self.rows, tr if tr is not None else (_empty_traces() if self.traces else None),
+                       self.traces_interval_s)
         self.rows, self.trs, self.last = [], [], time.monotonic()
 
 
@@ -224,6 +226,7 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     if workers is not None and workers < 1:
         raise SweepSpecError(f"--workers {workers}: must be >= 1")
     check_size(spec, out, traces, max_runs)
+    traced = spec.traces_interval_s if traces else None  #: the traces' interval, None without traces
     template = spec.template()
     points = spec.point_source()
     total = points.n
@@ -234,12 +237,11 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
         if scheduler is not None or total > CHECK_HERE_MAX:
             pool = batch.make_pool(workers, scheduler, connect_timeout_s)
             say.pool(pool)
-        checked = check_points(spec, template, points, pool or batch.SerialPool(),
-                               spec.traces_interval_s if traces else None)
+        checked = check_points(spec, template, points, pool or batch.SerialPool(), traced)
         clean_stale(out)
         index = IdIndex(checked.ids)
         try:
-            finished = Finished(out, pdir, index, traces)
+            finished = Finished(out, pdir, index, traced)
         except StoreError as exc:
             raise SweepSpecError(str(exc)) from None
         done0 = int(finished.done.sum())
@@ -253,14 +255,14 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
             backend = pool.describe()
             say.line(f"running {ran} runs on {backend}")
             size = chunk_size or spec.chunk_size or batch.auto_chunk_size(ran, pool.slots)
-            fn = partial(_run_item, traces_interval_s=spec.traces_interval_s if traces else None, row=metrics_row)
+            fn = partial(_run_item, traces_interval_s=traced, row=metrics_row)
             preload_writer()  # pandas' import (pyarrow's) overlaps the wait for the first rows
             failed, client_s = _run_pass(spec, pool, fn, _run_items(template, points, checked.ids, todo, size),
-                                         _Saver(pdir, spec.save_interval_s, traces), say, done0, total, on_progress)
+                                         _Saver(pdir, spec.save_interval_s, traced), say, done0, total, on_progress)
     finally:
         if pool is not None:
             pool.close(cancel=True)
-    finished = Finished(out, pdir, index, traces)
+    finished = Finished(out, pdir, index, traced)
     if not finished.done.all():
         raise RuntimeError(f"internal error: {int((~finished.done).sum())} runs have no result after the sweep")
     failed_total, flagged_total = finished.failed_count(), finished.flagged_count()

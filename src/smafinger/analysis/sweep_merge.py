@@ -15,7 +15,8 @@ import numpy as np
 
 from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, STRING_COLUMNS, TRACE_COLUMNS
 from ..files import atomic_write
-from .sweep_store import META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids, read_meta, traces_path
+from .sweep_store import (META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids, read_meta,
+                          traces_interval, traces_path)
 
 
 class Source:
@@ -109,11 +110,11 @@ def same_merge(out_meta: dict, traces: Path) -> bool:
 
 class Finished:
     """For every point: the newest finished row of its run (source, row), from ``OUT`` and
-    the parts. With ``traces``, a run finished without its trace does not count (a failed
-    run has none and counts)."""
+    the parts. With ``traces_interval_s``, a run finished without its trace at that interval
+    does not count (a failed run has none and counts)."""
 
-    def __init__(self, out: Path, pdir: Path, index: IdIndex, traces: bool):
-        self.index, self.traces = index, traces
+    def __init__(self, out: Path, pdir: Path, index: IdIndex, traces_interval_s: float | None = None):
+        self.index, self.traces, self.traces_interval_s = index, traces_interval_s is not None, traces_interval_s
         n = len(index.ids)
         self.src = np.full(n, -1, dtype=np.int32)
         self.row = np.zeros(n, dtype=np.int64)
@@ -128,7 +129,7 @@ class Finished:
             if self.out_meta is None:
                 raise StoreError(f"{out} exists and is not a smafinger sweep table; choose another --out or remove it")
             tp = traces_path(out)
-            has = bool(self.out_meta.get("traces")) and tp.exists()
+            has = bool(self.out_meta.get("traces")) and tp.exists() and self._usable(tp, legacy=False)
             src = Source(out, tp if has else None, is_out=True)
             if has and "point" in src.names and same_merge(self.out_meta, tp):
                 src.own_points = src.read_columns(["point"])["point"].to_numpy()
@@ -139,11 +140,21 @@ class Finished:
                     continue
                 tf = f.with_name(f.name[: -len(".parquet")] + ".traces.parquet")
                 try:
-                    src = Source(f, tf if tf.exists() else None)
+                    src = Source(f, tf if tf.exists() and self._usable(tf, legacy=True) else None)
                 except Exception:  # noqa: BLE001 - an unreadable part is simply redone
                     continue
                 self._add(src)
                 self.n_parts += 1
+
+    def _usable(self, traces: Path, legacy: bool) -> bool:
+        """Whether a traces file was sampled at this sweep's interval (no traces asked: any is).
+        ``legacy``: a file that states no interval (parts written before they did) is."""
+        if not self.traces:
+            return True
+        got = traces_interval(traces)
+        if got is None:
+            return legacy
+        return abs(got - self.traces_interval_s) <= 1e-9 * self.traces_interval_s
 
     def _add(self, src: Source) -> None:
         tab = src.read_columns(["run_id", "status"])

@@ -95,8 +95,9 @@ def rows_table(rows: list[dict]):
     return pa.table({k: [r.get(k) for r in rows] for k in names})
 
 
-def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
-    """One part: ``part-<time>-<uid>.parquet`` (+ ``.traces.parquet``, written first), each durable."""
+def write_part(pdir: Path, rows: list[dict], traces: dict | None, traces_interval_s: float | None = None) -> Path:
+    """One part: ``part-<time>-<uid>.parquet`` (+ ``.traces.parquet``, written first, stating the
+    interval its traces were sampled at), each durable."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -105,7 +106,7 @@ def write_part(pdir: Path, rows: list[dict], traces: dict | None) -> Path:
         fsync_dir(pdir.parent)
     stem = f"part-{time.time_ns():020d}-{uuid.uuid4().hex[:8]}"
     if traces is not None:
-        ttab = pa.table(traces)
+        ttab = pa.table(traces).replace_schema_metadata({META_KEY: json.dumps({"interval_s": traces_interval_s})})
         atomic_write(pdir / f"{stem}.traces.parquet", lambda tmp: pq.write_table(ttab, tmp), durable=True)
     tab = rows_table(rows)
     path = pdir / f"{stem}.parquet"
@@ -120,6 +121,16 @@ def read_meta(path: Path) -> dict | None:
     if META_KEY not in meta:
         return None
     return json.loads(meta[META_KEY])
+
+
+def traces_interval(path: Path) -> float | None:
+    """The interval a traces file (``OUT.traces`` or a part's) says its runs were sampled at;
+    None if it says none (parts written before they did) or cannot be read."""
+    try:
+        value = (read_meta(path) or {}).get("interval_s")
+    except Exception:  # noqa: BLE001 - unreadable: no interval
+        return None
+    return float(value) if value is not None else None
 
 
 def _ids(column) -> np.ndarray:
