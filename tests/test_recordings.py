@@ -224,6 +224,48 @@ def test_mat_plain_vectors_take_the_mapped_time_vector(tmp_path):
     assert "no time vector 't_s'" in refusal(f)
 
 
+@pytest.mark.parametrize("layout", ["array", "simulink", "table"])
+def test_mat_signals_with_their_own_time_and_a_mapped_time(tmp_path, layout):
+    """[time, value] arrays, Structures With Time and table-like structs carry their own time,
+    read in seconds as saved. A mapped t_s that gives the same times is fine; one that does not
+    (the times saved in ms and t_s=t_ms*1e-3, or a name that is not there) used to be ignored,
+    leaving the times 1000x too long; now the signal is refused, naming both."""
+    t_ms = np.arange(0.0, 100.0, 10.0)
+    duty, theta = np.full(t_ms.size, 0.3), -40 + 0.1 * t_ms
+    f = tmp_path / f"{layout}.mat"
+    if layout == "array":
+        variables = {"duty": np.c_[t_ms, duty], "theta_deg": np.c_[t_ms, theta]}
+    elif layout == "simulink":
+        variables = {"duty": simulink(t_ms, duty), "theta_deg": simulink(t_ms, theta)}
+    else:
+        variables = {"run": {"time": t_ms[:, None], "duty": duty[:, None], "theta_deg": theta[:, None]}}
+    sio.savemat(f, {**variables, "t_ms": t_ms[:, None], "t_same": t_ms[:, None]})
+    np.testing.assert_array_equal(read_recording(f).input.t_s, t_ms)  # as saved
+    np.testing.assert_array_equal(read_recording(f, {"t_s": "t_same"}).input.t_s, t_ms)
+    for mapping, got in (("t_ms*1e-3", "t_s=t_ms*0.001 (10 times from 0 to 0.09 s)"),
+                         ("nonexistent/1000", "t_s=nonexistent*0.001 (no time vector")):
+        msg = refusal(f, {"t_s": mapping})
+        assert "with its own time (10 samples from 0 to 90 s" in msg and got in msg, msg
+        assert "remove t_s from the mapping" in msg
+
+
+def test_mat_two_column_signals_not_time_value_are_refused_with_a_mapped_time(tmp_path):
+    """An N x 2 matrix of two signals ([duty, position], Simulink's 'Array' format) with the time
+    in tout: its first column was read as the time (a ramp of duty passes as increasing times)."""
+    tout = np.linspace(0.0, 1.0, 21)
+    f = tmp_path / "two.mat"
+    sio.savemat(f, {"tout": tout[:, None], "sig": np.c_[np.linspace(0, 0.5, 21), np.linspace(0, 2e-3, 21)],
+                    "duty": np.linspace(0, 0.5, 21)[:, None]})
+    msg = refusal(f, {"t_s": "tout", "position_m": "sig"})
+    assert "variable 'sig': is an N x 2 [time, value] array" in msg and "t_s=tout" in msg
+
+
+def test_mat_two_by_two_matrix_is_refused_as_ambiguous(tmp_path):
+    f = tmp_path / "tiny.mat"
+    sio.savemat(f, {"duty": np.array([[0.0, 0.01], [0.2, 0.3]]), "theta_deg": np.c_[[0.0, 0.01, 0.02], [1, 2, 3]]})
+    assert "2 x 2 matrix" in refusal(f)
+
+
 def test_mat_provenance_and_other_variables(tmp_path):
     t = np.arange(0, 1, 0.1)
     f = tmp_path / "prov.mat"

@@ -13,6 +13,13 @@ Which variables hold signals, and under what source name:
 - **Plain vector**: its times come from the time vector variable ``t_s`` (or the one mapped
   to ``t_s``, e.g. ``--map t_s=tout``), times that mapping's scale.
 
+The first three carry their own time, read in seconds as saved. A mapping that names ``t_s``
+too must give the same times for the signals read from them, else the signal is refused
+(``t_s=t_ms*1e-3`` beside a ``[time, value]`` array saved in ms would otherwise be ignored,
+and an N x 2 array holding two signals, not ``[time, value]``, read with its first column as
+time). A 2 x 2 matrix is refused: whether it holds its samples by rows or by columns is not
+known.
+
 A struct named ``provenance`` is returned in ``meta``; other variables are listed as ignored.
 A variable that cannot be a signal is refused only if a signal is asked of it.
 """
@@ -26,6 +33,9 @@ import numpy as np
 from .mapping import SignalMap, Source
 from .signals import TIME, RawSignal, RecordingError
 
+#: how an N x 2 (or 2 x N) matrix is read, in messages
+ARRAY = "an N x 2 [time, value] array"
+
 
 @dataclass(frozen=True)
 class _Entry:
@@ -33,6 +43,7 @@ class _Entry:
     t_s: np.ndarray | None = None
     values: np.ndarray | None = None
     error: str = ""
+    own_time: str = ""  #: the layout that carries its own time ("" for a plain vector)
 
 
 class MatFile:
@@ -40,15 +51,20 @@ class MatFile:
 
     what = "variable"
 
-    def __init__(self, path, entries: dict[str, _Entry], meta: dict):
+    def __init__(self, path, entries: dict[str, _Entry], meta: dict,
+                 mapped_time: tuple[Source, np.ndarray | None] | None = None):
         self.path, self._entries, self.meta = str(path), entries, meta
         self.names = tuple(entries)
+        self._mapped_time = mapped_time  #: (source, its times in s, None if no vector) if the mapping names t_s
 
     def signal(self, source: Source) -> RawSignal:
-        """The source's values times ``source.scale``, on its own time; refuses a bad variable."""
+        """The source's values times ``source.scale``, on its own time; refuses a bad variable,
+        and one that carries its own time unlike the time the mapping names."""
         e = self._entries[source.name]
         if e.error:
             raise RecordingError(f"{e.where}: {e.error}")
+        if e.own_time and self._mapped_time is not None:
+            _check_own_time(e, *self._mapped_time)
         rows = np.arange(1, e.values.size + 1)
         return RawSignal(e.where, e.t_s, e.values * source.scale, rows, "sample", None)
 
@@ -88,7 +104,30 @@ def open_mat(path, smap: SignalMap) -> MatFile:
                                                    f"rename one or map the other")
             entries[name] = entry
     meta["ignored"] = tuple(meta["ignored"])
-    return MatFile(path, entries, meta)
+    mapped_time = (time_var, _time_vector(variables, time_var)) if TIME in smap else None
+    return MatFile(path, entries, meta, mapped_time)
+
+
+def _time_vector(variables, time_var: Source) -> np.ndarray | None:
+    """The time vector variable ``time_var`` names, in s (its scale applied); None if there is none."""
+    t = variables.get(time_var.name)
+    t = _unwrap(t) if t is not None else None
+    if not (isinstance(t, np.ndarray) and t.dtype.kind in "iuf" and t.ndim == 2 and min(t.shape) == 1):
+        return None
+    return t.astype(np.float64).ravel() * time_var.scale
+
+
+def _check_own_time(e: _Entry, time_var: Source, t: np.ndarray | None) -> None:
+    """Refuse a signal that carries its own time (``e.own_time``) when the mapping names a
+    ``t_s`` that does not give the same times."""
+    if t is not None and t.size == e.t_s.size and np.allclose(t, e.t_s, rtol=1e-9, atol=1e-12):
+        return
+    got = ("no time vector of that name" if t is None else
+           f"{t.size} times from {t[0]:g} to {t[-1]:g} s" if t.size else "an empty vector")
+    raise RecordingError(
+        f"{e.where}: is {e.own_time}, with its own time ({e.t_s.size} samples from {e.t_s[0]:g} to {e.t_s[-1]:g} s, "
+        f"read in seconds as saved), but the mapping names t_s={time_var.to_text()} ({got}); remove t_s from the "
+        "mapping, or save the signal as a plain vector beside its time vector")
 
 
 def _sources(path, var, value, variables, time_var: Source, meta):
@@ -107,10 +146,13 @@ def _sources(path, var, value, variables, time_var: Source, meta):
         return []
     if isinstance(s, np.ndarray) and s.dtype.kind in "iuf" and s.ndim == 2:
         a = s.astype(np.float64)
+        if a.shape == (2, 2):
+            return [(var, _Entry(where, error="is a 2 x 2 matrix: whether it is [time, value] by columns or by rows "
+                                              "is not known; save at least 3 samples"))]
         if a.shape[1] == 2:
-            return [(var, _Entry(where, a[:, 0].copy(), a[:, 1].copy()))]
+            return [(var, _Entry(where, a[:, 0].copy(), a[:, 1].copy(), own_time=ARRAY))]
         if a.shape[0] == 2 and a.shape[1] > 2:
-            return [(var, _Entry(where, a[0].copy(), a[1].copy()))]
+            return [(var, _Entry(where, a[0].copy(), a[1].copy(), own_time=ARRAY))]
         if min(a.shape) == 1:
             return [(var, _vector(where, a.ravel(), variables, time_var))]
     meta["ignored"].append(var)
@@ -120,12 +162,10 @@ def _sources(path, var, value, variables, time_var: Source, meta):
 
 
 def _vector(where, v, variables, time_var: Source) -> _Entry:
-    t = variables.get(time_var.name)
-    t = _unwrap(t) if t is not None else None
-    if not (isinstance(t, np.ndarray) and t.dtype.kind in "iuf" and t.ndim == 2 and min(t.shape) == 1):
+    t = _time_vector(variables, time_var)
+    if t is None:
         return _Entry(where, error=f"is a plain vector and there is no time vector {time_var.name!r}; "
                                    f"map one (e.g. --map t_s=tout) or save as Structure With Time")
-    t = t.astype(np.float64).ravel() * time_var.scale
     if t.size != v.size:
         return _Entry(where, error=f"has {v.size} samples but the time vector {time_var.name!r} has {t.size}")
     return _Entry(where, t, v)
@@ -155,7 +195,7 @@ def _simulink(path, var, s, meta):
         elif t.size != v.size:
             out.append((name, _Entry(w, error=f"time has {t.size} samples but signals.values has {v.size} rows")))
         else:
-            out.append((name, _Entry(w, t, v)))
+            out.append((name, _Entry(w, t, v, own_time="a Structure With Time")))
     return out
 
 
@@ -174,7 +214,7 @@ def _table(path, var, s):
         elif t.size != v.size:
             out.append((f, _Entry(w, error=f"has {v.size} samples but {var}.time has {t.size}")))
         else:
-            out.append((f, _Entry(w, t, v)))
+            out.append((f, _Entry(w, t, v, own_time="a field of a struct with a time field")))
     return out
 
 
