@@ -105,6 +105,21 @@ def test_good_angle_file_and_column_aliases(tmp_path):
     assert c.voltage_V is None and c.angle_deg[0] == -40
 
 
+@pytest.mark.parametrize("header, unit, column", [
+    ("time_s,angle_rad", "'rad', but the angle is read in deg", "angle_rad"),
+    ("time [ms],angle [deg]", "'ms', but the time is read in s", "time [ms]"),
+    ("t (min),theta_deg", "'min', but the time is read in s", "t (min)"),
+    ("time_s,angle_deg,voltage (mV)", "'mv', but the voltage is read in v", "voltage (mV)"),
+])
+def test_a_unit_other_than_the_one_read_in_is_refused(tmp_path, header, unit, column):
+    """The unit in a header names what the numbers are: 'angle_rad' was read as degrees, and
+    'time [ms]' as seconds whenever the times stayed under 600."""
+    rows = [header] + [f"{0.1 * i:.2f},{-0.7 + 0.01 * i:.3f},5" for i in range(30)]
+    msg = error_of(load_angle_curve, write(tmp_path / "u.csv", rows))
+    assert f"line 1: column {column!r} is in {unit}" in msg
+    assert load_angle_curve(write(tmp_path / "ok.csv", ["Time [sec],Angle (°),V"] + rows[1:])).t_s.size == 30
+
+
 @pytest.mark.parametrize("row, replacement, expected", [
     (4, "0.3,", "row 4 (line 5): angle is missing (empty field)"),
     (4, "0.3", "row 4 (line 5): angle column missing"),

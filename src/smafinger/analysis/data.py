@@ -9,8 +9,10 @@ Two kinds of file:
   (up to the row of maximum temperature), then the cooling half.
 - **Angle-vs-time curves** of the joint (the paper's Fig. 9): CSV with a header naming the
   columns time [s] and angle [deg], and optionally voltage [V] (the upper wire's drive).
-  Recognised names (case-insensitive, units in brackets or after ``_`` ignored): ``time``/``t``,
-  ``angle``/``theta``, ``voltage``/``v``/``v_upper``.
+  Recognised names (case-insensitive, a unit in brackets or after ``_``): ``time``/``t``,
+  ``angle``/``theta``, ``voltage``/``v``/``v_upper``. A unit given must be the one the column
+  is read in (s, deg, V; :data:`UNITS`): ``angle_rad`` or ``time [ms]`` is refused, not read
+  as degrees or seconds.
 
 Any problem raises :class:`DataError` with one line naming the file, the row and the problem.
 "Row N" counts data rows from 1; the file's line number is given too.
@@ -228,6 +230,10 @@ _ALIASES = {
     "voltage": ("voltage", "v", "v_upper", "voltage_upper", "u"),
 }
 _UNIT_SUFFIX = re.compile(r"(\[.*\]|\(.*\)|_(s|sec|deg|degrees|v|volt|volts|rad)$)")
+#: the units each column is read in, as a header may write them (lower case)
+UNITS = {"time": ("s", "sec", "secs", "second", "seconds"),
+         "angle": ("deg", "degree", "degrees", "°"),
+         "voltage": ("v", "volt", "volts")}
 
 
 def _canonical(name: str) -> str | None:
@@ -238,6 +244,15 @@ def _canonical(name: str) -> str | None:
         if key in names:
             return canon
     return None
+
+
+def _unit(name: str) -> str | None:
+    """The unit a header name gives (in brackets, parentheses or after the last ``_``), lower
+    case; None if it gives none."""
+    m = _UNIT_SUFFIX.search(name.strip().lower())
+    if m is None:
+        return None
+    return (m.group(2) or m.group(1)[1:-1]).strip()
 
 
 def load_angle_curve(path: str | Path) -> AngleCurve:
@@ -253,6 +268,10 @@ def load_angle_curve(path: str | Path) -> AngleCurve:
     for j, name in enumerate(header):
         c = _canonical(name)
         if c is not None and c not in cols:
+            unit = _unit(name)
+            if unit is not None and unit not in UNITS[c]:
+                raise DataError(f"{_where(path, line=head_ln)}: column {name.strip()!r} is in {unit!r}, but the {c} is "
+                                f"read in {UNITS[c][0]}: convert the column to {UNITS[c][0]} and name it so")
             cols[c] = j
     found = ", ".join(repr(h.strip()) for h in header)
     for need, unit in (("time", "s"), ("angle", "deg")):
