@@ -99,6 +99,43 @@ def read_provenance_of(result, folder):
     return read_provenance(folder / "first.json")
 
 
+def _cli(*args) -> None:
+    from smafinger.cli import main
+
+    assert main(list(args)) == 0
+
+
+def test_a_thinned_result_says_so_and_its_re_run_writes_every_sample(tmp_path, monkeypatch):
+    """A decimated result's file used to state the run alone, as if it held every sample; a
+    re-run from a file that keeps every 10th sample (reproduce's) wrote every sample but copied
+    ``samples_every: 10`` into its own provenance and summary (found by review)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SMAFINGER_ENGINE", "compiled")
+    r = simulate("paper2010", "cooperative", "0:-25", t_end_s=1.0)
+    thin = r.decimated(5).decimated(2)
+    assert thin.samples_every == 10 and thin.metrics == r.metrics
+    thin.save("thin.csv")
+    assert json.loads(sidecar_path("thin.csv").read_text())["samples_every"] == 10
+    assert len(pd.read_csv("thin.csv")) == 101
+    _cli("simulate", "--from", "thin.csv", "--out", "again.csv", "--summary", "again.json", "--no-progress")
+    assert len(pd.read_csv("again.csv")) == 1001
+    assert "samples_every" not in json.loads(sidecar_path("again.csv").read_text())
+    assert "samples_every" not in json.loads((tmp_path / "again.json").read_text())["provenance"]
+    r.save("whole.csv")
+    assert "samples_every" not in json.loads(sidecar_path("whole.csv").read_text())
+
+
+def test_a_scenario_re_run_from_its_mat_file_is_the_same_file(tmp_path, monkeypatch):
+    """The MATLAB file's provenance gave back the run alone: a re-run from it lost the
+    scenario's name, and so its bytes differed from the first file's (found by review)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SMAFINGER_ENGINE", "compiled")
+    _cli("simulate", "--scenario", "fig11-controller-on-v1", "--t-end", "1", "--out", "s.mat", "--no-progress")
+    assert read_provenance(tmp_path / "s.mat")["scenario"] == "fig11-controller-on-v1"
+    _cli("simulate", "--from", "s.mat", "--out", "again.mat", "--no-progress")
+    assert (tmp_path / "s.mat").read_bytes() == (tmp_path / "again.mat").read_bytes()
+
+
 def test_files_without_a_definition_are_refused(tmp_path):
     (tmp_path / "x.json").write_text('{"segments": []}')
     (tmp_path / "y.csv").write_text("t_s\n0\n")

@@ -55,6 +55,8 @@ def check_suffix(path: str | Path, allowed, what: str) -> str:
 def add_signals(outputs: Outputs, result, path: str | Path, what: str = "--out", **extra) -> None:
     """Stage the signals as CSV (and its sidecar), Parquet or MATLAB by ``path``'s suffix."""
     fmt = SIGNAL_FORMATS[check_suffix(path, SIGNAL_FORMATS, what)]
+    if result.samples_every != 1:  # a thinned result (SimulationResult.decimated): the file says so
+        extra.setdefault("samples_every", result.samples_every)
     prov = provenance(result.spec, **extra)
     if fmt == "csv":
         names = list(result.column_names)
@@ -200,6 +202,7 @@ def _read_errors() -> tuple[type[BaseException], ...]:
 
 
 def _mat_provenance(path: Path) -> dict:
+    import numpy as np
     from scipy.io import loadmat
 
     data = loadmat(path, squeeze_me=True, chars_as_strings=True)
@@ -207,8 +210,10 @@ def _mat_provenance(path: Path) -> dict:
         return _none(path)
     prov = data["provenance"]
     record = {"run": json.loads(str(prov["run_json"][()]))}
-    if "run_sha256" in prov.dtype.names:
-        record["run_sha256"] = str(prov["run_sha256"][()])
+    for name in prov.dtype.names:  # run_sha256, and what the run recorded beside it (a scenario's name)
+        value = prov[name][()]
+        if name not in ("run", "run_json") and isinstance(value, (str, np.generic)):
+            record[name] = value if isinstance(value, str) else value.item()
     return record
 
 

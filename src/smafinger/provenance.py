@@ -23,6 +23,9 @@ from typing import Any
 
 #: bump when the meaning of a run definition changes
 SCHEMA = 1
+#: provenance keys that describe the file's samples, not the run (``samples_every``: the file
+#: keeps every n-th output sample); a re-run (``--from``) writes every sample and leaves them out
+FILE_KEYS = ("samples_every",)
 #: run definition keys, besides ``schema``, ``mechanism`` and ``parameters``
 RUN_KEYS = ("strategy", "profile", "drive", "t_end_s", "dt_s", "method", "pwm", "output_interval_s", "tol_deg",
             "tol_m", "hold_s", "independent_wait")

@@ -37,6 +37,8 @@ class SimulationResult:
     engine: str = "compiled"  #: the kernel that ran: compiled, or interpreted (engine.interpreted)
     #: the recorded fields if not every signal (``run_spec(record="metrics")``: a sweep's runs)
     recorded: tuple[str, ...] | None = None
+    #: every how many of the run's output samples this result keeps (:meth:`decimated`)
+    samples_every: int = 1
     _metrics: dict | None = field(default=None, repr=False)
 
     # ---- signals ---------------------------------------------------------------------
@@ -94,11 +96,12 @@ class SimulationResult:
             raise AttributeError(name) from None
 
     def decimated(self, every: int) -> "SimulationResult":
-        """The result thinned to every ``every``-th sample, its metrics kept at full resolution."""
+        """The result thinned to every ``every``-th sample, its metrics kept at full resolution;
+        its saved files say so (``samples_every`` in their provenance)."""
         metrics = self.metrics
         return dataclasses.replace(self, mechanism_signals=np.ascontiguousarray(self.mechanism_signals[:, ::every]),
                                    wire_signals=np.ascontiguousarray(self.wire_signals[..., ::every]),
-                                   _metrics=metrics)
+                                   samples_every=self.samples_every * every, _metrics=metrics)
 
     def to_pandas(self):
         import pandas as pd

@@ -135,12 +135,14 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
 
     if from_ is not None:
         from ..export import read_provenance
-        from ..provenance import spec_from_provenance
+        from ..provenance import FILE_KEYS, spec_from_provenance
 
         refuse(ctx, RUN_OPTIONS, f"with --from {from_}: it re-runs the run recorded there")
         record = read_provenance(from_)
-        same = {k: v for k, v in record.items() if k not in ("smafinger_version", "run", "run_sha256")}
-        return spec_from_provenance(record, f"--from {from_}"), same  # what the first run recorded, as it did
+        # what the first run recorded beside its definition (a scenario's name), as it did; not what
+        # described its file's samples (FILE_KEYS): the re-run writes every sample
+        same = {k: v for k, v in record.items() if k not in ("smafinger_version", "run", "run_sha256", *FILE_KEYS)}
+        return spec_from_provenance(record, f"--from {from_}"), same
     programs = [(k, v) for k, v in (("voltage", voltage), ("duty", duty), ("current", current)) if v is not None]
     if len(programs) > 1:
         raise UsageError(f"give one drive program, not {' and '.join('--' + k for k, _ in programs)}")
