@@ -193,3 +193,32 @@ def test_sweep_run_ids_take_any_number_of_wires_and_keep_the_joint_text():
     assert canonical_run(joint)["voltage"] == "0.0:8.0:0.0,8.0:0.0:0.0"  # the text run ids were made from
     rig = make_spec("linear-bias-spring", "open-loop", None, "0:8,2:0", t_end_s=3.0)
     assert canonical_run(rig)["voltage"] == "0.0:8.0,2.0:0.0" and len(run_id(rig)) == 16
+
+
+def test_a_given_resistance_calibration_is_part_of_the_run(tmp_path):
+    """The resistance controller's calibration is what maps resistance to position: a run's
+    definition holds it, so a re-run uses it (before, a calibration given through the API was
+    left out, the re-run calibrated anew and ran differently under the same hash; found by
+    review). A definition written before holds none and re-runs calibrating anew, as it did."""
+    import dataclasses
+
+    from smafinger.control.calibration import calibrate
+    from smafinger.control.params import ResistanceFeedbackParameters
+
+    p = get("paper2010")
+    cal = calibrate(p)
+    custom = dataclasses.replace(cal, c0=cal.c0 + 0.1)
+    spec = make_spec(p, "cooperative", "0:-25", t_end_s=2.0, controller=ResistanceFeedbackParameters(calibration=custom))
+    record = json.loads(json.dumps(provenance(spec)))
+    assert record["run"]["controller"]["calibration"]["c0"] == custom.c0
+    again = spec_from_provenance(record)
+    assert again == spec and again.controller.calibration == custom
+    np.testing.assert_array_equal(run_spec(again).theta_deg, run_spec(spec).theta_deg)
+    # as a definition without the calibration was written: the hash of the rest
+    old = json.loads(json.dumps(provenance(make_spec(p, "cooperative", "0:-25", t_end_s=2.0, controller="resistance"))))
+    del old["run"]["controller"]["calibration"]
+    old["run_sha256"] = definition_hash(old["run"])
+    assert spec_from_provenance(old).controller.calibration == cal
+    old["run"]["controller"]["K_P_per_q"] = 123.0  # an edited one is still refused
+    with pytest.raises(ProvenanceError, match="does not match run_sha256"):
+        spec_from_provenance(old)

@@ -225,6 +225,28 @@ class ResistanceFeedbackParameters(ControllerParameters):
     #: the resistance-to-position map; None: calibrated for the set when the record is built
     calibration: ResistanceCalibration | None = None
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        cal = self.calibration
+        if isinstance(cal, dict):  # as to_dict writes it (a run definition read back)
+            try:
+                cal = ResistanceCalibration(**{k: tuple(v) if isinstance(v, list) else v for k, v in cal.items()})
+            except TypeError as exc:
+                raise ParameterError(f"{self.label}: calibration = {self.calibration!r} is not a calibration "
+                                     f"({exc})") from None
+            object.__setattr__(self, "calibration", cal)
+        elif cal is not None and not isinstance(cal, ResistanceCalibration):
+            raise ParameterError(f"{self.label}: calibration = {cal!r} is not a ResistanceCalibration")
+
+    def to_dict(self) -> dict[str, Any]:
+        """As every controller's, and the calibration if one was given (its fields): a run's
+        definition must hold it, or a re-run would calibrate anew. Left out when the record
+        calibrates for the set, as before it was written."""
+        out = super().to_dict()
+        if self.calibration is not None:
+            out["calibration"] = dataclasses.asdict(self.calibration)
+        return out
+
     def prepared(self, p: ParameterSet) -> "ResistanceFeedbackParameters":
         """Calibrated for ``p`` (:func:`~.calibration.calibrate`: a dozen short runs) if not yet."""
         return self if self.calibration is not None else self.replace(calibration=calibrate(p))
