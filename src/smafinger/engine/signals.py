@@ -44,7 +44,10 @@ SIGNALS: tuple[Signal, ...] = (
     Signal("force", True, "N", "force_{wire}_N", doc="wire tension sigma S_w"),
     Signal("arm", True, "m", "arm_{wire}_m", mechanisms=("joint",), doc="moment arm b (Eqs. 4b, 5b)"),
     Signal("spring", True, "m", "spring_{wire}_m", mechanisms=("joint",), doc="tendon spring elongation"),
-    Signal("V", True, "V", "V_{wire}_V", doc="voltage (current, in A, with a current drive) at the sample"),
+    Signal("V", True, "V", "V_{wire}_V", doc="the drive at the sample: with the exact PWM the level applied then "
+           "(V_H in the on part of a period, V_L in the off part); with the averaged PWM the period's RMS, "
+           "sqrt(d V_H^2 + (1 - d) V_L^2) (pwm.averaged_drive), so V^2 / R is the mean power either way; "
+           "a current in A with a current drive"),
     Signal("duty", True, "%", "duty_{wire}", doc="PWM duty DC% (Eq. 12)"),
     # --- added in smafinger 0.2 -------------------------------------------------------------
     Signal("electrical", True, "J", "electrical_energy_{wire}_J",
