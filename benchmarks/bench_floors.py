@@ -208,7 +208,8 @@ def bench_sweep(rounds: int, n_runs: int = 1000) -> None:
     print(f"\n[3] {n_runs:,} full-cycle sweep runs (60 s, the long step) on {cores} cores (goal: <= 5 s); medians of "
           f"{rounds} rounds")
     print(f"    one worker's work per run, alone  : {1e3 * med['work']:6.2f} ms (min {1e3 * min(times['work']):.2f})")
-    print(f"    a 2-run smafinger sweep process   : {med['fixed']:6.2f} s (the fixed cost; min {min(times['fixed']):.2f})")
+    print(f"    a 2-run smafinger sweep process   : {med['fixed']:6.2f} s (the fixed cost; "
+          f"min {min(times['fixed']):.2f})")
     print(f"    bound: fixed + {n_runs:,} x work / {cores} cores = {bound:.1f} s (goal 5 s; the cores' slowing of "
           "each other not counted: bench_scale.py [1])")
 

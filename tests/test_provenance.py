@@ -208,7 +208,8 @@ def test_a_given_resistance_calibration_is_part_of_the_run(tmp_path):
     p = get("paper2010")
     cal = calibrate(p)
     custom = dataclasses.replace(cal, c0=cal.c0 + 0.1)
-    spec = make_spec(p, "cooperative", "0:-25", t_end_s=2.0, controller=ResistanceFeedbackParameters(calibration=custom))
+    spec = make_spec(p, "cooperative", "0:-25", t_end_s=2.0,
+                     controller=ResistanceFeedbackParameters(calibration=custom))
     record = json.loads(json.dumps(provenance(spec)))
     assert record["run"]["controller"]["calibration"]["c0"] == custom.c0
     again = spec_from_provenance(record)
