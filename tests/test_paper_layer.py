@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from smafinger.paper.scenario import V_H
 from smafinger.parameters import ParameterError, get
 from smafinger.paper import findings as F
 from smafinger.paper.claim import Check, Claim, Verdict
@@ -260,3 +261,19 @@ def test_move_findings_pick_the_closest_definition():
     assert "Co-operative (paper: 9.17 s per move): closest mean 5.00 s (reached; as specified); 0 of 1" in text
     assert "37.5 = 3 x 10 + 7.5 and 27.5 = 2 x 10 + 7.5, the same 7.5 s last move for both" in text
     assert "smafinger's last moves end 7.0 s and 3.9 s into their 10 s" in text
+
+
+@pytest.mark.parametrize("name", ["fig8-h0-65-upper-v1", "sec31-vh-8.5-lower-v1", "fig10a-two-node-v1"])
+def test_open_loop_scenarios_drive_at_the_runs_own_v_h(name):
+    """The open-loop scenarios drive a wire at the set's V_H. Their programs were written with
+    Table II's 8 V when the module was imported, so '--set V_H_V=4' was recorded in the run's
+    parameters and changed nothing it did (found by review: the same energy to the last digit)."""
+    from smafinger import scenarios
+
+    s = scenarios.get(name)
+    assert V_H in s.voltage
+    base = s.spec()
+    levels = {v for step in base.voltage.steps for v in step[1:] if v}
+    assert levels == {base.params.V_H_V}
+    four = s.spec(overrides=["V_H_V=4"])
+    assert four.params.V_H_V == 4.0 and {v for step in four.voltage.steps for v in step[1:] if v} == {4.0}

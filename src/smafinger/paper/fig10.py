@@ -29,7 +29,7 @@ from .claim import Check, Claim, increasing, known, spread
 from .derived import OnOffCycles
 from .fmt import nums
 from .overrides import Overrides
-from .scenario import MOVE_S, PAPER_FRICTION, Figure, Scenario
+from .scenario import MOVE_S, PAPER_FRICTION, V_H, Figure, Scenario
 
 PARAMS = "paper2010"
 P2010 = get_params(PARAMS)
@@ -46,9 +46,9 @@ ON_OFF_S = tuple((k * (ON_S + OFF_S), k * (ON_S + OFF_S) + ON_S) for k in range(
 CASING = Overrides.of(casing_heat_capacity_J_mK=CASING_HEAT_CAPACITY_J_MK, casing_loss_W_mK=CASING_LOSS_W_MK)
 
 
-def _program(volts: float) -> str:
-    """Open-loop voltage program: the upper wire at ``volts`` during each on-time, 0 V otherwise."""
-    return ",".join(f"{on:g}:{volts:g}:0,{off:g}:0:0" for on, off in ON_OFF_S)
+def _program() -> str:
+    """Open-loop voltage program: the upper wire at the set's V_H during each on-time, 0 V otherwise."""
+    return ",".join(f"{on:g}:{V_H}:0,{off:g}:0:0" for on, off in ON_OFF_S)
 
 
 def _scenario(model: str) -> Scenario:
@@ -58,7 +58,7 @@ def _scenario(model: str) -> Scenario:
         description=(f"Fig. 10(a), Sec. 3.2: open loop, {P2010.V_H_V:g} V on the upper wire for {ON_S:g} s then "
                      f"{OFF_S:g} s off, {CYCLES} times; {model} thermal model, casing "
                      f"{CASING_HEAT_CAPACITY_J_MK:g} J/(m K) and {CASING_LOSS_W_MK:g} W/(m K) per metre of wire"),
-        params=PARAMS, strategy="open-loop", voltage=_program(P2010.V_H_V), t_end_s=ON_OFF_S[-1][0] + ON_S + OFF_S,
+        params=PARAMS, strategy="open-loop", voltage=_program(), t_end_s=ON_OFF_S[-1][0] + ON_S + OFF_S,
         overrides=ov, group="fig10a", panel=model, wire="upper",
         label="two-node: wire -> casing air -> open air" if model == "two-node" else "single node (Eq. 11)",
         derive=OnOffCycles(ON_OFF_S, "upper"))

@@ -32,6 +32,9 @@ PAPER_FRICTION = Overrides.of(friction_sticking="initial-only")
 OPEN_LOOP_ON_S = 20.0
 #: closed-loop moves of Figs. 11-13: time each target is held [s]
 MOVE_S = 10.0
+#: in a scenario's voltage program, the set's V_H, resolved after every override (a ``--set V_H_V``
+#: included): ``"0:V_H:0,20:0:0"``
+V_H = "V_H"
 
 
 @dataclass(frozen=True)
@@ -87,8 +90,10 @@ class Scenario:
               .then(Overrides.of(**{k: v for k, v in given.items() if v is not None})))
         run = {"strategy": self.strategy, "profile": self.profile, "t_end_s": self.t_end_s}
         run.update(ov.settings())
-        return make_spec(ov.apply(get_params(self.params)), voltage=self.voltage, dt_s=dt_s,
-                         method=method, output_interval_s=output_interval_s, pwm=pwm, **run)
+        p = ov.apply(get_params(self.params))
+        voltage = None if self.voltage is None else self.voltage.replace(V_H, repr(p.V_H_V))
+        return make_spec(p, voltage=voltage, dt_s=dt_s, method=method, output_interval_s=output_interval_s,
+                         pwm=pwm, **run)
 
     def definition(self) -> dict:
         """The scenario as plain values (for ``summary.json``)."""
@@ -117,4 +122,4 @@ class Figure:
                 raise ValueError(f"scenario {s.name!r}: group {s.group!r} is not figure {self.key!r}")
 
 
-__all__ = ["Scenario", "Figure", "PAPER_FRICTION", "OPEN_LOOP_ON_S", "MOVE_S"]
+__all__ = ["Scenario", "Figure", "PAPER_FRICTION", "OPEN_LOOP_ON_S", "MOVE_S", "V_H"]

@@ -15,7 +15,7 @@ from .claim import Check, Claim, decreasing, increasing, spread
 from .derived import OpenLoop
 from .fmt import nums
 from .overrides import Overrides
-from .scenario import OPEN_LOOP_ON_S, PAPER_FRICTION, Figure, Scenario
+from .scenario import OPEN_LOOP_ON_S, PAPER_FRICTION, V_H, Figure, Scenario
 
 PARAMS = "paper2010-table2"
 TABLE2 = get_params(PARAMS)
@@ -51,8 +51,8 @@ class Variation:
         ov = PAPER_FRICTION.then(Overrides.of(**{f: v for f in self.fields}))
         if self.spring_given:
             ov = ov.then(Overrides.of(spring_init="given"))
-        volts = ov.apply(TABLE2).V_H_V
-        on = f"{volts:g}:0" if wire == "upper" else f"0:{volts:g}"
+        volts = ov.apply(TABLE2).V_H_V  # for the description; the program takes the run's own V_H
+        on = f"{V_H}:0" if wire == "upper" else f"0:{V_H}"
         return Scenario(
             name=f"{self.key}-{shown}{'mm' if self.unit == 'mm' else ''}-{wire}-v1",
             figure=self.figure,
