@@ -48,6 +48,9 @@ def refused(result, text):
     (["--fit", "{d}/notes.txt"], "unknown format '.txt'"),
     (["--fit", "{d}/joint.csv"], "the output is theta_rad but a linear-bias-spring set"),
     (["--fit", "{d}/a.csv", "--validate", "{d}/a.csv"], "given twice"),
+    # the same file spelled two ways: a 'held-out' run that was fitted (found by review)
+    (["--fit", "{d}/a.csv", "--validate", "{d}/./a.csv"], "given twice (as '{d}/a.csv' and '{d}/./a.csv')"),
+    (["--fit", "{d}/a.csv", "--fit", "{d}/../{n}/a.csv"], "given twice"),
     (["--fit", "{d}/a.csv", "--map", "duty=u*abc"], "'abc' after '*'"),
     (["--fit", "{d}/a.csv::duty=u_pwm"], "mapping duty=u_pwm: no column 'u_pwm'"),
     (["--fit", "{d}/a.csv", "--free", "A_S0_C:90:95"], "start value 68"),
@@ -68,8 +71,8 @@ def refused(result, text):
 ])
 def test_refusals_are_one_line_with_status_2_and_write_nothing(files, args, text):
     before = sorted(p.name for p in files.iterdir())
-    r = invoke("--params", "linear-bias-spring", *[a.format(d=files) for a in args], "--workers", "1")
-    refused(r, text)
+    r = invoke("--params", "linear-bias-spring", *[a.format(d=files, n=files.name) for a in args], "--workers", "1")
+    refused(r, text.format(d=files))
     assert sorted(p.name for p in files.iterdir()) == before
 
 

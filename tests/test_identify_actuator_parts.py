@@ -210,6 +210,16 @@ def test_csv_and_simulink_mat_give_the_same_run(tmp_path):
     assert b.recording.meta["format"] == "mat"
 
 
+def test_the_baseline_ends_where_the_input_leaves_its_rest_value(tmp_path):
+    """A rig idling at a small duty (a sensing current, a PWM that never quite stops) is at rest
+    until its input first changes, as for closed-loop runs; the baseline used to end at the
+    first input above zero, one sample, with no noise estimate (found by review)."""
+    for idle in (0.0, 0.002):
+        run = bs.open_loop_run(LINEAR, f"0:{idle},0.3:0.4,1.5:0", 2.0, noise=2e-5, offset=1e-3, seed=4)
+        bs.write_csv(tmp_path / "r.csv", run, digits=17)
+        assert load_open_loop(tmp_path / "r.csv", None, "fit", LINEAR).baseline.sum() == 31, idle
+
+
 def test_bench_run_refusals(tmp_path):
     run = bs.open_loop_run(JOINT, "0:0:0,0.2:0.5:0", 0.5, seed=1)
     bs.write_csv(tmp_path / "joint.csv", run)

@@ -249,7 +249,7 @@ def load_open_loop(path, mapping, role: str, p: ParameterSet, wire: str | None =
     _check_role(role)
     rec = _read(path, mapping, p).with_time_origin()
     interval, t_end, samples = _grid(rec, "input", dt_s)
-    on = np.flatnonzero(rec.input.values > 0.0)
+    on = np.flatnonzero(rec.input.values != rec.input.values[0])  # the input leaves its rest value
     t_rest = float(rec.input.t_s[on[0]]) if on.size else math.inf
     return BenchRun(str(path), role, "open-loop", rec, samples, interval, t_end,
                     _rest_mask(rec.output.t_s, t_rest), program=drive_program(rec, p, wire))
