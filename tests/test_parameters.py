@@ -90,3 +90,22 @@ def test_toml_with_base_and_errors(tmp_path):
     f.write_text('base = "paper2010"\nfoo = 1.0\n')
     with pytest.raises(ParameterError, match="unknown parameter"):
         resolve(str(f))
+
+
+@pytest.mark.parametrize("base", ['base = "paper2010"\n', None])
+def test_an_option_given_twice_in_a_file_is_refused(tmp_path, base):
+    """At the top level and in [options]: the top-level one used to win without a word, as in a
+    full file (params --out) with one line added at its top (found by review)."""
+    from smafinger.parameters.files import to_toml
+
+    f = tmp_path / "p.toml"
+    if base:
+        f.write_text(base + 'hysteresis = "deadband"\n[options]\nhysteresis = "memory"\n')
+    else:  # a whole set as params --out writes it, one line added at the top
+        f.write_text('thermal_model = "two-node"\n' + to_toml(get("paper2010")))
+    with pytest.raises(ParameterError, match=r"(hysteresis|thermal_model) is given twice, at the top level "
+                                             r"\('(deadband|two-node)'\) and in \[options\]"):
+        resolve(str(f))
+    f.write_text('base = "paper2010"\nV_H_V = 6\n[options]\nV_H_V = 10\n')  # a parameter in [options]
+    with pytest.raises(ParameterError, match=r"unknown option\(s\) in \[options\]: V_H_V"):
+        resolve(str(f))

@@ -82,7 +82,16 @@ def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> Param
     options = data.pop("options", {})
     if not isinstance(options, dict):
         raise ParameterError("options must be a table ([options])")
-    options.update({k: data.pop(k) for k in list(data) if k in OPTION_NAMES})
+    top = {k: data.pop(k) for k in list(data) if k in OPTION_NAMES}
+    twice = sorted(set(top) & set(options))
+    if twice:  # one would silently win over the other
+        k = twice[0]
+        raise ParameterError(f"{k} is given twice, at the top level ({top[k]!r}) and in [options] ({options[k]!r}); "
+                             "give it once")
+    options = {**options, **top}
+    unknown_opt = sorted(set(options) - set(OPTION_NAMES))
+    if unknown_opt:
+        raise ParameterError(f"unknown option(s) in [options]: {', '.join(unknown_opt)}")
     label = data.pop("mechanism", None)
     if base_name is not None:
         base = registry_get(base_name)
@@ -100,9 +109,6 @@ def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> Param
     missing = [m for m in sorted(set(names) - set(data)) if _required(cls, m)]
     if missing:
         raise ParameterError(f"missing parameter(s) {', '.join(missing)} (or give base = \"NAME\" of a named set)")
-    unknown_opt = sorted(set(options) - set(OPTION_NAMES))
-    if unknown_opt:
-        raise ParameterError(f"unknown option(s): {', '.join(unknown_opt)}")
     missing_opt = sorted(set(OPTION_NAMES) - set(options))
     if missing_opt:
         raise ParameterError(f"missing option(s) {', '.join(missing_opt)} (or give base = \"NAME\" of a named set)")
