@@ -275,6 +275,9 @@ def fit_actuator(runs: Sequence[BenchRun], box: FreeBox, pool, settings: FitSett
         notes.append("the Jacobian is rank deficient: some fitted values are not identified by these runs")
     if start_eval.failures:
         notes.append(f"the start set failed on a run ({start_eval.failures[0]})")
+    if log["status"] == 0 or log["evaluations"] >= settings.max_nfev:
+        notes.append(f"the local fit stopped at its limit of {settings.max_nfev} evaluations (--max-nfev), not at a "
+                     "minimum: the values and their errors may still change with more")
     n = box.n
     return ActuatorFit(
         free=box.free, params=box.params(u), start=box.values(u_start), values=box.values(u),
