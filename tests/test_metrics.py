@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from smafinger import metrics as M
+from smafinger import simulate
 
 T = np.round(np.arange(0.0, 20.0 + 1e-9, 1e-3), 9)  # a 1 ms grid, like a run's output
 signals = st.lists(st.floats(-60.0, 60.0, allow_nan=False), min_size=2, max_size=200).map(np.array)
@@ -211,15 +212,31 @@ def _segments(reached, hold_s=0.5):
 @given(st.lists(st.floats(0.1, 20.0), min_size=1, max_size=5), st.floats(0.0, 3.0))
 def test_cycle_time_on_reach_is_the_sum_of_reached_s(reached, hold_s):
     segs = _segments(reached, hold_s)
-    cyc = M.cycle_time(segs, n_on_reach=len(segs) - 1, hold_s=hold_s)
-    assert cyc == pytest.approx(M.reached_sum(segs), abs=1e-9)
-    assert M.elapsed_time(segs) == pytest.approx(cyc + (len(segs) - 1) * hold_s, abs=1e-9)
+    n = len(segs)
+    cyc = M.cycle_time(segs, n, n_on_reach=n - 1, hold_s=hold_s)
+    assert cyc == pytest.approx(M.reached_sum(segs, n), abs=1e-9)
+    assert M.elapsed_time(segs, n) == pytest.approx(cyc + (n - 1) * hold_s, abs=1e-9)
 
 
 def test_a_cycle_that_does_not_finish_has_no_time():
     segs = _segments([5.0, None])
-    assert M.elapsed_time(segs) is None and M.cycle_time(segs, 1, 0.5) is None
-    assert M.reached_sum(segs) is None
+    assert M.elapsed_time(segs, 2) is None and M.cycle_time(segs, 2, 1, 0.5) is None
+    assert M.reached_sum(segs, 2) is None
+
+
+def test_a_cycle_whose_last_segments_never_started_has_no_time():
+    """Every segment that started was reached, but the run ended before the last one's start
+    time: the time of that part of the cycle was reported as the cycle's (found by review: 15.05 s
+    for '0:-25,10:-55,30:-40' over 20 s)."""
+    segs = _segments([5.0, 4.0])
+    assert M.elapsed_time(segs, 3) is None and M.cycle_time(segs, 3, 0, 0.5) is None
+    assert M.reached_sum(segs, 3) is None
+    assert M.elapsed_time(segs, 2) == pytest.approx(9.5)
+    from smafinger.paper.derived import cycle_metrics
+
+    r = simulate("paper2010", "cooperative", "0:-25,10:-55,30:-40", t_end_s=20.0)
+    assert [s["index"] for s in r.summary()["segments"]] == [0, 1]
+    assert cycle_metrics(r) == {"cycle_s": None, "elapsed_s": None, "reached_sum_s": None}
 
 
 def test_reduction():

@@ -24,9 +24,10 @@ def cycle_metrics(result: SimulationResult) -> dict:
     """A closed-loop run's cycle times: ``cycle_s`` (:func:`~smafinger.metrics.cycle_time`),
     ``elapsed_s`` (time from 0) and ``reached_sum_s``."""
     segs = result.summary()["segments"]
+    n = len(result.spec.profile.segments)
     n_on_reach = sum(1 for s in result.spec.profile.segments if s.start_s is None)
-    return {"cycle_s": M.cycle_time(segs, n_on_reach, result.spec.hold_s),
-            "elapsed_s": M.elapsed_time(segs), "reached_sum_s": M.reached_sum(segs)}
+    return {"cycle_s": M.cycle_time(segs, n, n_on_reach, result.spec.hold_s),
+            "elapsed_s": M.elapsed_time(segs, n), "reached_sum_s": M.reached_sum(segs, n)}
 
 
 def segment_detail(result: SimulationResult, index: int) -> dict:
