@@ -39,10 +39,11 @@ def test_bandwidth_of_a_first_order_lag():
     assert 0.02 < bandwidth_hz([0.02, 0.05], [0.94, 0.0]) < 0.021
 
 
-def _record(t, q, q_ref, segments, unit="deg", T=None, violations=0, energy=12.5):
+def _record(t, q, q_ref, segments, unit="deg", T=None, violations=0, energy=12.5, n_segments=None):
     T = np.full_like(t, 40.0) if T is None else T
     return RunRecord(unit, ("a",), t, q, q_ref, {"a": T.astype(np.float32)}, {"a": np.zeros_like(t, np.float32)},
-                     {"a": np.zeros_like(t, np.float32)}, tuple(segments), energy, violations)
+                     {"a": np.zeros_like(t, np.float32)}, tuple(segments), energy, violations,
+                     len(segments) if n_segments is None else n_segments)
 
 
 def test_move_scores_on_a_constructed_response():
@@ -76,6 +77,12 @@ def test_cycle_time_is_the_sum_of_reach_times_and_none_if_one_is_missing():
     s = task_scores(task, _record(t, q, q_ref, segs))
     assert s["cycle_s"] == 12.0 and s["time_to_target_s"] == 4.0 and s["unreached"] == 0
     s = task_scores(task, _record(t, q, q_ref, segs[:2] + [(8.0, 30.0, 1.0, None)]))
+    assert s["cycle_s"] is None and s["unreached"] == 1
+    # stuck at the first target: the two targets never issued are unreached too, and the run
+    # ended before the last target's issue: no cycle (found by review: 1 unreached, not 3)
+    s = task_scores(task, _record(t, q, q_ref, [(0.0, 30.0, 5.0, None)], n_segments=3))
+    assert s["cycle_s"] is None and s["unreached"] == 3
+    s = task_scores(task, _record(t, q, q_ref, segs[:2], n_segments=3))
     assert s["cycle_s"] is None and s["unreached"] == 1
 
 
@@ -113,6 +120,33 @@ def test_speed_goal_excludes_hotter_and_violating_runs():
     assert g["met"]
     g = goals(_rows([("pid", "cooperative", 10.0, 100.0, 0), ("ok", "cooperative", 7.5, 99.0, 0)]))["speed"]
     assert not g["met"] and g["best"]["faster"] == pytest.approx(0.25)
+
+
+def test_speed_goal_is_not_measured_with_the_paper_pid_alone():
+    """With only the paper's PID on the cycle the goal said 'not met: no controller completed the
+    cycle...' (found by review): nothing was compared."""
+    from smafinger.bench.report import goals_markdown
+
+    g = goals(_rows([("pid", "cooperative", 10.0, 100.0, 0), ("pid", "independent", 11.0, 99.0, 0)]))
+    assert g["speed"] is None and "speed goal: not measured" in goals_markdown(g)
+
+
+def _holds(runs):
+    return pd.DataFrame([{"mechanism": "joint", "task": task, "controller": "resistance", "strategy": "cooperative",
+                          "unreached": u, "limit_cycle": cyc, "hold_error": err} for task, u, cyc, err in runs])
+
+
+def test_self_sensing_goal_needs_each_hold_reached_and_held():
+    """The verdict read the hold error (the window's mean) alone: a run that never reached its
+    target and oscillated +-2 deg about it passed (found by review)."""
+    good = [("hold-extension", 0, 0.16, 0.08), ("hold-flexion", 0, 0.10, 0.18)]
+    assert goals(_holds(good))["self_sensing"]["met"]
+    for bad in [("hold-flexion", 1, 4.0, 0.0), ("hold-flexion", 0, 1.2, 0.1), ("hold-flexion", 0, 0.1, 0.6),
+                ("hold-flexion", 0, None, None)]:
+        g = goals(_holds(good[:1] + [bad]))["self_sensing"]
+        assert not g["met"], bad
+    g = goals(_holds(good[:1] + [("hold-flexion", 1, 4.0, 0.0)]))["self_sensing"]
+    assert g["unreached"]["hold-flexion/cooperative"] == 1 and g["limit_cycle_deg"]["hold-flexion/cooperative"] == 4.0
 
 
 def test_task_selection_rejects_unknown_names():

@@ -67,10 +67,12 @@ def test_a_hotter_faster_candidate_ranks_below_a_cooler_slower_one(over_C):
 def test_a_tiny_tuning_end_to_end(tmp_path):
     out = tmp_path / "tuned.json"
     r = CliRunner().invoke(app, ["tune", "pid", "-m", "linear-bias-spring", "-t", "sine-0.5hz", "--budget", "4",
-                                 "--popsize", "2", "-w", "1", "--out", str(out)])
+                                 "--popsize", "2", "-w", "1", "--out", str(out), "--set", "K_I_per_q_s=100"])
     assert r.exit_code == 0, r.output
     doc = json.loads(out.read_text())
-    assert set(doc["values"]) == {"K_P_per_q", "K_V_s_per_q", "K_I_per_q_s"}
+    # a field fixed with --set is left out of the default free fields (found by review: it was tuned
+    # anyway and reported as fixed)
+    assert set(doc["values"]) == {"K_P_per_q", "K_V_s_per_q"} and doc["fixed"] == ["K_I_per_q_s=100"]
     assert doc["evaluations"] >= 4 and math.isfinite(doc["objective"])
     # the best objective never gets worse from one generation to the next
     assert all(b <= a for a, b in zip(doc["history"], doc["history"][1:]))
@@ -81,6 +83,9 @@ def test_a_tiny_tuning_end_to_end(tmp_path):
     (["pid", "-t", "fig15-cycle", "--budget", "0"], "--budget 0"),
     (["pid", "-t", "fig15-cycle", "-p", "K_P_per_q=1"], "NAME=LO:HI"),
     (["pid", "-t", "fig15-cycle", "-p", "K_pct=1:2"], "K_pct"),
+    # a field given with --set and tuned too: the JSON reported as fixed a value the search moved
+    (["pid", "-t", "fig15-cycle", "--set", "K_P_per_q=3000", "-p", "K_P_per_q=1000:5000"],
+     "K_P_per_q is both fixed (--set) and free (--param)"),
 ])
 def test_tune_bad_input_is_one_line_exit_2(tmp_path, args, names):
     out = tmp_path / "never.json"

@@ -5,7 +5,7 @@
 - ``time_to_target_s``: mean over segments of the time to enter the target for good (within
   the run's tolerance for its hold time; the engine's rule); ``cycle_s``: their sum, the full
   cycle time of Fig. 15 (every target issued on reach);
-- ``unreached``: segments whose target was never reached;
+- ``unreached``: segments whose target was never reached, issued or not;
 - ``overshoot``: the largest overshoot past a segment's target in the direction of its move;
 - ``settling_s``: the longest time for a segment to stay within :data:`SETTLE_BAND` of its target;
 - ``limit_cycle``: the largest peak-to-peak of q over the last :data:`~.tasks.HOLD_WINDOW_S`
@@ -61,6 +61,7 @@ class RunRecord:
     segments: tuple
     energy_J: float
     violations: int
+    n_segments: int  #: the profile's segments (those that never started are not in ``segments``)
 
 
 def record_of(result) -> RunRecord:
@@ -85,7 +86,7 @@ def record_of(result) -> RunRecord:
         {w: f32(f"T_{w}_C") for w in p.wire_names}, {w: f32(f"duty_{w}") for w in p.wire_names},
         {w: f32(f"R_{w}_ohm") for w in p.wire_names}, tuple(segs),
         float(sum(result.signal(f"electrical_energy_{w}_J")[-1] for w in p.wire_names)),
-        int(result.interlock_violations))
+        int(result.interlock_violations), len(result.spec.profile.segments))
 
 
 def task_scores(task: Task, rec: RunRecord) -> dict:
@@ -102,7 +103,7 @@ def task_scores(task: Task, rec: RunRecord) -> dict:
         out["phase_deg"] = math.degrees(math.remainder(ph - ph_ref, 2.0 * math.pi))
     else:
         out["rms_error"] = float(np.sqrt(np.mean((q - q_ref) ** 2))) * scale
-        out.update(_segment_scores(t, q, rec.segments, rec.unit, scale))
+        out.update(_segment_scores(t, q, rec.segments, rec.n_segments, rec.unit, scale))
         if task.kind != "cycle":
             del out["cycle_s"]
     out["energy_J"] = rec.energy_J
@@ -111,7 +112,9 @@ def task_scores(task: Task, rec: RunRecord) -> dict:
     return out
 
 
-def _segment_scores(t, q, segments, unit: str, scale: float) -> dict:
+def _segment_scores(t, q, segments, n_segments: int, unit: str, scale: float) -> dict:
+    """Scores of the segments that started; a target never issued (the run ended first, or a
+    target before it was never reached) counts as unreached, and leaves the cycle unfinished."""
     reached = [r for *_, r in segments if r is not None]
     overshoot, settle, cycle, error = 0.0, 0.0, None, None
     q_prev = float(q[0])
@@ -126,8 +129,8 @@ def _segment_scores(t, q, segments, unit: str, scale: float) -> dict:
         q_prev = target
     return {
         "time_to_target_s": float(np.mean(reached)) if reached else None,
-        "cycle_s": float(sum(reached)) if len(reached) == len(segments) else None,
-        "unreached": len(segments) - len(reached),
+        "cycle_s": float(sum(reached)) if len(reached) == n_segments else None,
+        "unreached": n_segments - len(reached),
         "overshoot": overshoot * scale,
         "settling_s": None if math.isinf(settle) else settle,
         "limit_cycle": None if cycle is None else cycle * scale,

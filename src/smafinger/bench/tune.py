@@ -181,15 +181,24 @@ def _scores(tasks, controllers, strategy, pool) -> list[list[dict] | None]:
 def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "cooperative",
          free: Sequence[FreeParam] | None = None, max_peak_T_C: float | None = None, budget: int = 120,
          popsize: int = 10, seed: int = 1, workers: int | None = None,
-         report: Callable[[str], None] | None = None) -> TuneResult:
-    """CMA-ES on the free fields of ``base`` over ``tasks`` (one mechanism); see the module docstring."""
+         report: Callable[[str], None] | None = None, fixed: Sequence[str] = ()) -> TuneResult:
+    """CMA-ES on the free fields of ``base`` over ``tasks`` (one mechanism); see the module docstring.
+
+    ``fixed``: fields given their values (``--set``): left out of the default free fields, and
+    refused among explicit ones (the search would tune a value reported as fixed)."""
     say = report or (lambda msg: None)
     mechs = {t.mechanism for t in tasks}
     if len(mechs) != 1:
         raise ValueError(f"tune on one mechanism at a time, not {', '.join(sorted(mechs))}")
     p = tasks[0].params()
     base = base.prepared(p)
-    free = tuple(free) if free is not None else default_free(base.label, p)
+    if free is not None:
+        both = sorted({f.name for f in free} & set(fixed))
+        if both:
+            raise ValueError(f"{both[0]} is both fixed (--set) and free (--param): give it one way")
+        free = tuple(free)
+    else:
+        free = tuple(f for f in default_free(base.label, p) if f.name not in set(fixed))
     known = set(base.field_names())
     for f in free:
         if f.name not in known:

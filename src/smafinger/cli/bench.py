@@ -142,7 +142,7 @@ def tune(
         free = [FreeParam.parse(x) for x in param] or None
         base = controller_from(controller, set_)
         res = run_tune(base, tasks, strategy, free, max_peak_temperature_c, budget, popsize, seed, workers,
-                       report=_say)
+                       report=_say, fixed=[a.split("=", 1)[0].strip() for a in set_])
     except (ValueError, ParameterError) as exc:
         _fail(str(exc))
     except BatchError as exc:
