@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from smafinger.bench.report import goals
-from smafinger.bench.scores import RunRecord, bandwidth_hz, sine_fit, task_scores
+from smafinger.bench.scores import Bandwidth, RunRecord, bandwidth, bandwidth_hz, sine_fit, task_scores
 from smafinger.bench.tasks import HOLD_WINDOW_S, Task, select_tasks
 
 
@@ -35,8 +35,13 @@ def test_bandwidth_of_a_first_order_lag():
     assert bandwidth_hz([0.1, 0.2], [0.5, 0.4]) == 0.1  # below already at the lowest
     # a dip at a low frequency does not count: the last crossing does
     assert bandwidth_hz([0.5, 1.0, 4.0, 8.0], [0.3, 1.0, 0.25, 0.1]) == pytest.approx(math.sqrt(2.0), rel=1e-12)
-    # a run that did not move (gain 0) is floored, not dropped
-    assert 0.02 < bandwidth_hz([0.02, 0.05], [0.94, 0.0]) < 0.021
+    # a run that did not move (gain 0): only the bracket is known. Interpolating to a floored gain
+    # put it just above the lower frequency whatever the controller (0.204 Hz between 0.2 and 0.5;
+    # found by review)
+    assert bandwidth([0.02, 0.05], [0.94, 0.0]) == Bandwidth(None, "between", 0.02, 0.05)
+    assert bandwidth([0.1, 0.2, 0.5], [0.96, 0.95, 1e-9]) == Bandwidth(None, "between", 0.2, 0.5)
+    assert bandwidth([0.1, 0.2, 0.5], [0.96, 0.95, 0.05]).bound == "="  # a run that moved: interpolated
+    assert bandwidth([0.1, 0.2], [0.5, 0.4]) == Bandwidth(0.1, "<=") and bandwidth([0.1], [0.9]).bound == ">"
 
 
 def _record(t, q, q_ref, segments, unit="deg", T=None, violations=0, energy=12.5, n_segments=None):

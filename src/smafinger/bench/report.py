@@ -51,8 +51,8 @@ def task_table(rows: pd.DataFrame) -> str:
 def bandwidth_markdown(bw: pd.DataFrame) -> str:
     lines = ["| controller | strategy | -3 dB bandwidth [Hz] |", "|---|---|---|"]
     for _, r in bw.iterrows():
-        shown = {">": f"> {r['above_hz']:g}", "<=": f"≤ {r['below_hz']:g}"}.get(r["bound"],
-                                                                                 f"{r['bandwidth_hz']:.3g}")
+        shown = {">": f"> {r['above_hz']:g}", "<=": f"≤ {r['below_hz']:g}",
+                 "between": f"{r['below_hz']:g}-{r['above_hz']:g}"}.get(r["bound"], f"{r['bandwidth_hz']:.3g}")
         lines.append(f"| {r['controller']} | {r['strategy']} | {shown} |")
     return "\n".join(lines)
 

@@ -19,7 +19,7 @@ from ..engine.batch import run_batch
 from ..engine.defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM
 from ..engine.run import make_spec
 from .presets import BENCH_CONTROLLERS, bench_controller
-from .scores import RunRecord, bandwidth_hz, record_of, task_scores
+from .scores import RunRecord, bandwidth, record_of, task_scores
 from .tasks import Task
 
 STRATEGIES = ("independent", "cooperative")
@@ -117,11 +117,12 @@ def bandwidth_table(rows: pd.DataFrame, tasks: Sequence[Task]) -> pd.DataFrame:
     sines = rows[rows["kind"] == "sine"]
     for (mech, label, strategy), g in sines.groupby(["mechanism", "controller", "strategy"], sort=False):
         fs = [freq[(mech, n)] for n in g["task"]]
-        bw = bandwidth_hz(fs, list(g["gain"]))
-        # "<=": already below -3 dB at the lowest frequency tried; ">": never below (bandwidth_hz None)
-        bound = ">" if bw is None else "<=" if bw == min(fs) else "="
-        out.append({"mechanism": mech, "controller": label, "strategy": strategy, "bandwidth_hz": bw,
-                    "bound": bound, "below_hz": min(fs), "above_hz": max(fs)})
+        bw = bandwidth(fs, list(g["gain"]))
+        # "<=": already below -3 dB at the lowest frequency tried (below_hz); ">": never below (above the
+        # highest, above_hz); "between": in (below_hz, above_hz), the run at above_hz did not move
+        low, high = (bw.low_hz, bw.high_hz) if bw.bound == "between" else (min(fs), max(fs))
+        out.append({"mechanism": mech, "controller": label, "strategy": strategy, "bandwidth_hz": bw.hz,
+                    "bound": bw.bound, "below_hz": low, "above_hz": high})
     return pd.DataFrame(out)
 
 

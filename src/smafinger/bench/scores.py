@@ -32,7 +32,7 @@ from .tasks import HOLD_WINDOW_S, Task
 SETTLE_BAND = {"deg": 0.5, "m": 0.2e-3}
 #: user unit -> the unit the bench reports (the slider's metres as millimetres)
 REPORT_SCALE = {"deg": (1.0, "deg"), "m": (1e3, "mm")}
-#: the smallest gain used in the bandwidth's log-log interpolation
+#: a gain at or below this is a run that did not move: no log-log interpolation to it (:func:`bandwidth`)
 GAIN_FLOOR = 1e-6
 
 
@@ -138,24 +138,44 @@ def _segment_scores(t, q, segments, n_segments: int, unit: str, scale: float) ->
     }
 
 
-def bandwidth_hz(frequencies: list[float], gains: list[float]) -> float | None:
+@dataclass(frozen=True)
+class Bandwidth:
+    """A -3 dB bandwidth as the sine tasks bound it: ``hz`` with ``bound`` ``"="`` (interpolated),
+    ``"<="`` (at most the lowest frequency tried, ``hz``), ``">"`` (above the highest, ``hz``
+    None) or ``"between"`` (somewhere in (``low_hz``, ``high_hz``), ``hz`` None: the run at
+    ``high_hz`` did not move, so no interpolation says where)."""
+
+    hz: float | None
+    bound: str
+    low_hz: float | None = None
+    high_hz: float | None = None
+
+
+def bandwidth(frequencies: list[float], gains: list[float]) -> Bandwidth:
     """The -3 dB bandwidth: above the highest frequency whose gain is at least 1/sqrt(2), where
     the gain falls below it for good, interpolated in log-log between that sine task and the
     next (a dip at a lower frequency, e.g. from stick-slip at a slow sine, does not count).
-    ``None`` if no frequency tried falls below (the bandwidth is above the highest); the lowest
-    frequency if none reaches the level (the bandwidth is at most that). Gains are floored at
-    :data:`GAIN_FLOOR` (a run that did not move at all) for the interpolation."""
-    pts = sorted((f, max(float(g), GAIN_FLOOR)) for f, g in zip(frequencies, gains)
-                 if g is not None and math.isfinite(g))
+    Above the highest frequency tried if none falls below; at most the lowest if none reaches
+    the level. When the next task's gain is at or below :data:`GAIN_FLOOR` (a run that did not
+    move at all), only the bracket is known: interpolating to the floor gave a value the floor
+    set (0.204 Hz between 0.2 and 0.5 Hz whatever the controller)."""
+    pts = sorted((f, float(g)) for f, g in zip(frequencies, gains) if g is not None and math.isfinite(g))
     if not pts:
-        return None
+        return Bandwidth(None, ">")
     level = 1.0 / math.sqrt(2.0)
     above = [k for k, (_, g) in enumerate(pts) if g >= level]
     if not above:
-        return pts[0][0]
+        return Bandwidth(pts[0][0], "<=")
     k = above[-1]
     if k == len(pts) - 1:
-        return None
+        return Bandwidth(None, ">", high_hz=pts[-1][0])
     (f0, g0), (f1, g1) = pts[k], pts[k + 1]
+    if g1 <= GAIN_FLOOR:
+        return Bandwidth(None, "between", f0, f1)
     x = (math.log(level) - math.log(g0)) / (math.log(g1) - math.log(g0))
-    return float(math.exp(math.log(f0) + x * (math.log(f1) - math.log(f0))))
+    return Bandwidth(float(math.exp(math.log(f0) + x * (math.log(f1) - math.log(f0)))), "=", f0, f1)
+
+
+def bandwidth_hz(frequencies: list[float], gains: list[float]) -> float | None:
+    """:func:`bandwidth`'s value: None above the highest frequency tried or within a bracket."""
+    return bandwidth(frequencies, gains).hz
