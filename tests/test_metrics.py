@@ -242,3 +242,19 @@ def test_a_cycle_whose_last_segments_never_started_has_no_time():
 def test_reduction():
     assert M.reduction(37.5, 27.5) == pytest.approx(10.0 / 37.5)
     assert M.reduction(None, 27.5) is None
+
+
+def test_a_target_never_pursued_is_said_and_has_no_overshoot():
+    """'0:-25,reach:-55,3:-40': -25 deg is reached after 3 s, so the -55 deg segment starts and
+    ends in the same instant. Its overshoot was reported as 0.0 beside energies of None, and
+    nothing said the target was skipped (found by review)."""
+    r = simulate("paper2010", "cooperative", "0:-25,reach:-55,3:-40", t_end_s=12.0)
+    s = r.summary()
+    seg1 = next(x for x in s["segments"] if x["index"] == 1)
+    assert seg1["start_s"] == seg1["end_s"] and seg1["overshoot_deg"] is None
+    assert seg1["peak_temperature_C"] == {"upper": None, "lower": None}
+    assert [w for w in s["warnings"] if "never pursued" in w] == [
+        f"segment 1 (target -55 deg) was never pursued: the next segment started at the same time, "
+        f"t = {seg1['start_s']:.6g} s"]
+    assert not any("never pursued" in w for w in simulate("paper2010", "cooperative", "0:-25,reach:-55",
+                                                          t_end_s=12.0).summary()["warnings"])

@@ -675,8 +675,8 @@ def test_absurd_runs_are_flagged_in_their_warnings_column(tmp_path):
     assert run_sweep(spec, out, workers=1).flagged_total == 1  # resumed: read back from the table
     r = _cli([str(spec), "--out", "c.parquet", "--workers", "1"], tmp_path)
     assert r.exit_code == 0, r.output
-    assert "1 of 2 runs have plausibility warnings" in r.output
-    assert "plausibility warnings" not in _cli([str(_write(tmp_path, SMALL)), "--workers", "1"], tmp_path).output
+    assert "1 of 2 runs have warnings" in r.output
+    assert "runs have warnings" not in _cli([str(_write(tmp_path, SMALL)), "--workers", "1"], tmp_path).output
 
 
 @pytest.mark.parametrize("first_fails", [True, False])

@@ -338,7 +338,7 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         f"target_{unit}": span.target,
         "enable": span.enable,
         "reached_s": span.reached_s,
-        f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction),
+        f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction) if some else None,
         "energy_J": electrical,
         "electrical_energy_J": electrical,
         **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) if some else None for w, e in heat_J.items()}}

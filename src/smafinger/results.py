@@ -202,4 +202,12 @@ def compute_metrics(result: SimulationResult) -> dict:
             "energy_J": m["energy_J"], "electrical_energy_J": m["energy_J"], "heat_J": m["heat_J"],
             "peak_temperature_C": m["peak_temperature_C"],
             "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations,
-            "warnings": check(result)}
+            "warnings": skipped_targets(spans, unit) + check(result)}
+
+
+def skipped_targets(spans: list, unit: str) -> list[str]:
+    """A warning per segment that started and ended in the same instant: its target was never
+    pursued (a later segment's start time had come when it started on reach, e.g. profile
+    ``0:-25,reach:-55,3:-40`` whose -25 deg is reached after 3 s)."""
+    return [f"segment {s.index} (target {s.target:g} {unit}) was never pursued: the next segment started at the same "
+            f"time, t = {s.start_s:.6g} s" for s in spans[:-1] if s.end_s <= s.start_s]

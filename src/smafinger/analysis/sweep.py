@@ -160,7 +160,7 @@ class SweepReport:
     backend: str
     #: failed runs in the whole table (this invocation's and resumed ones)
     failed_total: int = 0
-    #: runs in the whole table with plausibility warnings (their ``warnings`` column)
+    #: runs in the whole table with warnings (their ``warnings`` column)
     flagged_total: int = 0
     #: the client's own time in the run pass, per run that ran (s)
     client_s_per_run: float = math.nan

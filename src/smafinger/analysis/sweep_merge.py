@@ -179,8 +179,8 @@ class Finished:
         return self._count("status", lambda status: status == "error")
 
     def flagged_count(self) -> int:
-        """Runs of the sweep whose finished row has plausibility warnings (rows written before
-        the ``warnings`` column existed have none)."""
+        """Runs of the sweep whose finished row has warnings (rows written before the
+        ``warnings`` column existed have none)."""
         return self._count("warnings", lambda w: np.array([bool(x) for x in w], dtype=bool))
 
     def _count(self, column: str, which) -> int:

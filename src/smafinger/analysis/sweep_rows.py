@@ -58,13 +58,14 @@ METRIC_COLUMNS = (
     "motion_start_s", "steps", "wall_s",
     # the numerics the run used (engine.numerics: a point's varied values can change its default)
     "run_method", "run_dt_s", "run_pwm",
-    # the run's plausibility warnings (smafinger.plausibility: physically absurd results), "; "-joined
+    # the run's warnings (its metrics': physically absurd results, smafinger.plausibility; a target never
+    # pursued), "; "-joined
     "warnings",
 )
 INT_COLUMNS = ("interlock_violations", "steps")
 #: text columns (the others are numbers)
 STRING_COLUMNS = ("run_id", "status", "error", "run_method", "run_pwm", "warnings")
-#: joins a run's plausibility warnings in its ``warnings`` column ("" when it has none)
+#: joins a run's warnings in its ``warnings`` column ("" when it has none)
 WARNINGS_SEPARATOR = "; "
 #: per-segment columns: target, start, reach time and overshoot (target and overshoot in every unit)
 SEGMENT_COLUMNS = (f"target_{UNITS[0]}", "start_s", "reached_s", f"overshoot_{UNITS[0]}",

@@ -81,8 +81,8 @@ def sweep(
     typer.echo(f"wrote {report.out}{extra}: {report.total} runs ({report.resumed} already done, "
                f"{report.failed_total} failed) in {report.wall_s:.1f} s on {report.backend}")
     if report.flagged_total:
-        print(f"smafinger: {report.flagged_total} of {report.total} runs have plausibility warnings (physically "
-              "absurd results: overheating, overstress or overstrain; see their warnings column)", file=sys.stderr)
+        print(f"smafinger: {report.flagged_total} of {report.total} runs have warnings (physically absurd results, "
+              "or a target never pursued; see their warnings column)", file=sys.stderr)
     if report.failed_total:
         every = report.failed_total == report.total
         print(f"smafinger: {'every run' if every else f'{report.failed_total} of {report.total} runs'} failed "
