@@ -232,6 +232,12 @@ def test_a_cycle_whose_last_segments_never_started_has_no_time():
     assert M.elapsed_time(segs, 3) is None and M.cycle_time(segs, 3, 0, 0.5) is None
     assert M.reached_sum(segs, 3) is None
     assert M.elapsed_time(segs, 2) == pytest.approx(9.5)
+    # a cool-down (no actuator enabled) is not a target to reach: authors2020's profile 1
+    cool = [{"index": 0, "start_s": 0.0, "reached_s": 3.3, "enable": "upper"},
+            {"index": 1, "start_s": 5.0, "reached_s": None, "enable": "none"},
+            {"index": 2, "start_s": 10.0, "reached_s": 2.3, "enable": "upper"}]
+    assert M.elapsed_time(cool, 3) == pytest.approx(12.3) and M.reached_sum(cool, 3) == pytest.approx(5.6)
+    assert M.elapsed_time([dict(cool[0], reached_s=None, enable="upper")] + cool[1:], 3) is None
     from smafinger.paper.derived import cycle_metrics
 
     r = simulate("paper2010", "cooperative", "0:-25,10:-55,30:-40", t_end_s=20.0)

@@ -8,8 +8,10 @@ from typing import Mapping, Sequence
 
 def _complete(segments: Sequence[Mapping], n_segments: int) -> bool:
     """Every one of the profile's ``n_segments`` segments started (the metrics list those that
-    did, in order: a cycle cut short by ``t_end_s`` lacks its last ones) and was reached."""
-    return len(segments) == n_segments > 0 and all(s["reached_s"] is not None for s in segments)
+    did, in order: a cycle cut short by ``t_end_s`` lacks its last ones) and was reached, but a
+    cool-down (``enable`` none: no actuator pursues its target) before the last."""
+    return (len(segments) == n_segments > 0 and segments[-1]["reached_s"] is not None
+            and all(s["reached_s"] is not None or s.get("enable") == "none" for s in segments))
 
 
 def elapsed_time(segments: Sequence[Mapping], n_segments: int) -> float | None:
@@ -37,9 +39,11 @@ def cycle_time(segments: Sequence[Mapping], n_segments: int, n_on_reach: int, ho
 
 
 def reached_sum(segments: Sequence[Mapping], n_segments: int) -> float | None:
-    """Sum of the segments' ``reached_s``; ``None`` unless every one of the ``n_segments``
-    started and was reached."""
-    return float(sum(s["reached_s"] for s in segments)) if _complete(segments, n_segments) else None
+    """Sum of the segments' ``reached_s`` (a cool-down's none); ``None`` unless every one of the
+    ``n_segments`` started and was reached (:func:`_complete`)."""
+    if not _complete(segments, n_segments):
+        return None
+    return float(sum(s["reached_s"] for s in segments if s["reached_s"] is not None))
 
 
 def reduction(slower_s: float | None, faster_s: float | None) -> float | None:
