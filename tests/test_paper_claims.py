@@ -102,7 +102,8 @@ def test_fig8_varies_h0_over_the_figures_values(wire):
 def test_open_loop_voltage_and_spring_lengths_come_from_the_parameter_set():
     table2 = sec31.TABLE2
     s = scenarios.get("fig8-h0-60-upper-v1")
-    assert s.voltage == f"0:{table2.V_H_V:g}:0,20:0:0"
+    assert s.voltage == "0:V_H:0,20:0:0"  # the run's own V_H (paper.scenario.V_H)
+    assert s.spec().voltage.steps == ((0.0, table2.V_H_V, 0.0), (20.0, 0.0, 0.0))
     middle = [s for s in sec31.SPRINGS["upper"].scenarios() if s.wire == "upper"][1]
     assert middle.spec().params.spring_length_upper_m == table2.spring_length_upper_m
 
