@@ -101,18 +101,15 @@ def _self_sensing(rows: pd.DataFrame) -> dict | None:
     def number(v):
         return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
-    per, held = {}, []
+    per, unreached, cycles, held = {}, {}, {}, []
     for _, r in holds.iterrows():
         key = f"{r['task']}/{r['strategy']}"
-        err, cycle = number(r["hold_error"]), number(r["limit_cycle"])
-        per[key] = err
-        held.append(int(r["unreached"]) == 0 and err is not None and err <= HOLD_TOLERANCE_DEG
-                    and cycle is not None and cycle / 2.0 <= HOLD_TOLERANCE_DEG)
+        per[key], cycles[key], unreached[key] = number(r["hold_error"]), number(r["limit_cycle"]), int(r["unreached"])
+        held.append(unreached[key] == 0 and per[key] is not None and per[key] <= HOLD_TOLERANCE_DEG
+                    and cycles[key] is not None and cycles[key] / 2.0 <= HOLD_TOLERANCE_DEG)
     errs = [v for v in per.values() if v is not None]
-    return {"hold_error_deg": per, "worst_deg": max(errs) if errs else None,
-            "unreached": {f"{r['task']}/{r['strategy']}": int(r["unreached"]) for _, r in holds.iterrows()},
-            "limit_cycle_deg": {f"{r['task']}/{r['strategy']}": number(r["limit_cycle"]) for _, r in holds.iterrows()},
-            "met": all(held)}
+    return {"hold_error_deg": per, "worst_deg": max(errs) if errs else None, "unreached": unreached,
+            "limit_cycle_deg": cycles, "met": all(held)}
 
 
 def goals_markdown(g: dict) -> str:

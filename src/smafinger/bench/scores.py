@@ -175,7 +175,3 @@ def bandwidth(frequencies: list[float], gains: list[float]) -> Bandwidth:
     x = (math.log(level) - math.log(g0)) / (math.log(g1) - math.log(g0))
     return Bandwidth(float(math.exp(math.log(f0) + x * (math.log(f1) - math.log(f0)))), "=", f0, f1)
 
-
-def bandwidth_hz(frequencies: list[float], gains: list[float]) -> float | None:
-    """:func:`bandwidth`'s value: None above the highest frequency tried or within a bracket."""
-    return bandwidth(frequencies, gains).hz
