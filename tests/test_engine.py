@@ -105,6 +105,24 @@ def test_interlock_never_violated_in_closed_loop(strategy):
         assert not both.any()
 
 
+@pytest.mark.parametrize("profile", ["0:-25,reach:-55:lower,reach:-40", "0:-55:lower,reach:-40"])
+def test_independent_waits_for_a_wire_a_segment_enabled_by_name(profile):
+    """Sec. 4.1's wait applies to whichever opposing wire is still transformed: after a segment
+    that enabled the lower wire by name, the strategy's next move with the upper wire starts only
+    once the lower wire is back to martensite (it used to start at once, xi_lower 0.27)."""
+    from smafinger.control.strategies import RELEASE_XI
+
+    r = simulate("paper2010", "independent", profile, t_end_s=18, method="rk4")
+    last = r.summary()["segments"][-1]
+    after = r.t >= last["start_s"]
+    first_upper = np.flatnonzero(after & (r.V_upper_V > 0))[0]
+    assert r.t[first_upper] > last["start_s"] + 1.0  # the lower wire was still hot when it started
+    assert r.xi_lower[first_upper] >= RELEASE_XI
+    nowait = simulate("paper2010", "independent", profile, t_end_s=18, method="rk4", independent_wait=False)
+    start = nowait.summary()["segments"][-1]["start_s"]
+    assert nowait.t[np.flatnonzero((nowait.t >= start) & (nowait.V_upper_V > 0))[0]] < start + 0.1
+
+
 @pytest.mark.parametrize("dt", [2e-3, 5e-4])
 def test_output_grid_independent_of_step(dt):
     r = simulate("paper2010", "cooperative", "0:-25", t_end_s=3, dt_s=dt, output_interval_s=1e-3)

@@ -16,7 +16,9 @@ Strategies:
 - ``open-loop``: a piecewise-constant program per wire, no controller.
 - ``independent`` (Sec. 4.1): one actuator at a time, the agonist of the desired motion; the
   other is a passive bias spring. Before a new agonist is used, the strategy waits for the end
-  of the previous agonist's cooling phase (its wire back to martensite).
+  of the previous agonist's cooling phase (its wire back to martensite): every wire pulling
+  against the new agonist, whether the strategy chose it or a segment enabled it by name, must
+  be back to martensite (xi >= ``RELEASE_XI``).
 - ``cooperative`` (Sec. 4.2): every actuator enabled; the antagonist heats as soon as the
   mechanism passes the target, i.e. just before the agonist starts cooling.
 

@@ -27,9 +27,9 @@ class Schedule(NamedTuple):
     next_seg: int  #: index of the next segment to start
     q_target: float
     enabled: int  #: bit mask of enabled wires
-    agonist: int  #: independent strategy: wire in use (NO_WIRE: none yet)
-    waiting: bool  #: independent strategy: waiting for the previous agonist to cool
-    wait_wire: int
+    agonist: int  #: independent strategy: the wire it chose last (NO_WIRE: none yet)
+    waiting: bool  #: independent strategy: waiting for the opposing wires to cool
+    wait_wire: int  #: the opposing wire waited for
     pending: int  #: the agonist to enable once the wait is over
     band_since: int  #: tick since which q has stayed within the tolerance (-1: outside)
     confirmed: bool  #: the current target has been reached (held for the hold time)
@@ -48,12 +48,27 @@ def _xi(model, state, inputs, geom, i):
 
 
 @njit(cache=True)
+def _unreleased_opponent(model, state, inputs, geom, ag):
+    """A wire pulling against wire ``ag`` that is not yet back to martensite (NO_WIRE: none)."""
+    for j in range(len(model.wires)):
+        if (model.wires[j].direction != model.wires[ag].direction
+                and _xi(model, state, inputs, geom, j) < RELEASE_XI):
+            return j
+    return NO_WIRE
+
+
+@njit(cache=True)
 def _independent(s, target, model, state, inputs, geom, wait_release):
-    """Sec. 4.1: enable the agonist, after the previous one has cooled back to martensite."""
+    """Sec. 4.1: enable the agonist once every wire pulling against it is back to martensite.
+
+    The wire waited for is whichever opposing wire is still transformed, whether the strategy
+    chose it or a segment enabled it by name.
+    """
     ag = agonist_of(model.wires, target, state.q, s.agonist)
-    if (wait_release and s.agonist != NO_WIRE and ag != s.agonist
-            and _xi(model, state, inputs, geom, s.agonist) < RELEASE_XI):
-        return Schedule(s.next_seg, target, 0, ag, True, s.agonist, ag, -1, False)
+    if wait_release and ag != NO_WIRE:
+        w = _unreleased_opponent(model, state, inputs, geom, ag)
+        if w != NO_WIRE:
+            return Schedule(s.next_seg, target, 0, ag, True, w, ag, -1, False)
     return Schedule(s.next_seg, target, 0 if ag == NO_WIRE else 1 << ag, ag, False, s.wait_wire, s.pending,
                     -1, False)
 
@@ -84,8 +99,12 @@ def advance(s, t, segs, seg_actual, strategy, wait_release, model, state, inputs
         s = with_field(s, "next_seg", k + 1)
         started = True
     if s.waiting and _xi(model, state, inputs, geom, s.wait_wire) >= RELEASE_XI:
-        s = with_field(with_field(s, "waiting", False), "enabled", 1 << s.pending)
-        started = True
+        w = _unreleased_opponent(model, state, inputs, geom, s.pending)
+        if w == NO_WIRE:
+            s = with_field(with_field(s, "waiting", False), "enabled", 1 << s.pending)
+            started = True
+        else:
+            s = with_field(s, "wait_wire", w)
     return s, started
 
 
