@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -264,3 +266,18 @@ def test_a_target_never_pursued_is_said_and_has_no_overshoot():
         f"t = {seg1['start_s']:.6g} s"]
     assert not any("never pursued" in w for w in simulate("paper2010", "cooperative", "0:-25,reach:-55",
                                                           t_end_s=12.0).summary()["warnings"])
+
+
+def test_a_segment_without_samples_is_shown_and_tabled_without_an_overshoot(capsys):
+    """Its overshoot of None reached the terminal table's format and a sweep row's float(): both
+    raised TypeError (the CLI fuzzer: a segment starting at t_end). The table shows '-', the row NaN."""
+    from smafinger.analysis.sweep_rows import metrics_row
+    from smafinger.cli.show import print_run
+
+    r = simulate("paper2010", "independent", "0:-20,1.8125:-20", t_end_s=1.8125)
+    assert r.summary()["segments"][1]["overshoot_deg"] is None
+    print_run(r)
+    last = [line for line in capsys.readouterr().out.splitlines() if line.strip().startswith("│ ")][-1]
+    assert last.split("│")[1:-1][-1].strip() == "-" and last.split("│")[1].strip() == "1"
+    row = metrics_row(r)
+    assert math.isnan(row["seg1_overshoot_deg"]) and row["seg0_overshoot_deg"] >= 0.0

@@ -103,7 +103,8 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         row[f"seg{i}_start_s"] = float(seg["start_s"]) if seg else math.nan
         reached = seg["reached_s"] if seg else None
         row[f"seg{i}_reached_s"] = math.nan if reached is None else float(reached)
-        row[f"seg{i}_overshoot_{unit}"] = float(seg[f"overshoot_{unit}"]) if seg else math.nan
+        over = seg[f"overshoot_{unit}"] if seg else None  # None: a segment with no output sample
+        row[f"seg{i}_overshoot_{unit}"] = math.nan if over is None else float(over)
     if traces_interval_s:
         row["_trace"] = trace(result, trace_step(traces_interval_s, result.spec.output_interval_s))
     return row

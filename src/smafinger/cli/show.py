@@ -19,8 +19,9 @@ def print_run(result) -> None:
     fmt = ".2f" if u == "deg" else ".5f"
     for s in m["segments"]:
         reached = "never" if s["reached_s"] is None else f"{s['reached_s']:.3f}"
+        over = s[f"overshoot_{u}"]  # None: the segment has no output sample (it began at the end)
         table.add_row(str(s["index"]), f"{s['start_s']:.3f}", format(s[f"target_{u}"], fmt), reached,
-                      format(s[f"overshoot_{u}"], fmt))
+                      "-" if over is None else format(over, fmt))
     console.print(table)
     wires = result.spec.params.wire_names
     e, pt, ps = m["energy_J"], m["peak_temperature_C"], m["peak_stress_Pa"]
