@@ -29,7 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
 
 from smafinger.bench.presets import bench_controller  # noqa: E402
-from smafinger.control.params import SlidingModeParameters  # noqa: E402
+from smafinger.control.params import PaperPID, SlidingModeParameters  # noqa: E402
 from smafinger.engine.run import make_spec, run_spec  # noqa: E402
 from smafinger.parameters import get  # noqa: E402
 
@@ -64,6 +64,9 @@ CASES = {
     "paper2010 PWM 20 ms": dict(params=_p(pwm_period_s=0.02), **COOP),
     "paper2010 PWM 20 ms, program": dict(params=_p(pwm_period_s=0.02), **PROGRAM),
     "paper2010 PWM 50 ms": dict(params=_p(pwm_period_s=0.05), **COOP),
+    "pid, the bench's tuning": dict(params="paper2010", **COOP,
+                                    controller=bench_controller("pid-tuned", get("paper2010"))),
+    "pid, K_V 300": dict(params="paper2010", **COOP, controller=PaperPID(K_V_s_per_q=300.0)),
     "sliding-mode": dict(params="paper2010", controller="sliding-mode", **COOP),
     "sliding-mode, independent": dict(params="paper2010", controller="sliding-mode", **IND),
     "sliding-mode, the bench's tuning": dict(params="paper2010", **COOP,

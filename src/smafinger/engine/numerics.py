@@ -11,7 +11,8 @@ validated for it against a run at a far shorter step with exact PWM edges:
   (:func:`.integrators.load_stiffness`), 5 ms, period-averaged PWM, in open loop only;
 - :data:`EDGE_STEP` on the finger joint where only the average is the trouble (a hysteresis
   rule that follows the PWM ripple, a PWM period longer than the step, the authors' 2020 model in
-  closed loop, the rapid-heating controller): exponential Euler with the PWM
+  closed loop, the rapid-heating controller, a controller at gains other than the ones the long
+  step was validated with): exponential Euler with the PWM
   resolved at its edges, so a sub-step ends at every edge and output sample, as with the
   reference, but costs one right-hand side instead of four;
 - the reference settings (RK4, 1 ms, exact PWM) everywhere else.
@@ -22,6 +23,7 @@ long-step default existed. Where each holds and why it does not elsewhere: docs/
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +67,15 @@ EDGE_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, DEFAULT_PWM)
 #: profile on paper2010-table2, 7 runs within 0.026 deg RMS and 0.16 max of rk4 at 0.1 ms.
 #: rapid-heating is not: 0.059 deg RMS, 0.41 max on the co-operative full cycle
 LONG_STEP_CONTROLLERS = ("pid", "sliding-mode")
+#: the sets whose own PID gains the long step was validated with in closed loop (every paper2010
+#: scenario). With other gains the period-averaged PWM can put reach times off by tenths of a
+#: second where the joint creeps into the tolerance band: on the full cycle co-operative against
+#: rk4 at 0.1 ms (benchmarks/bench_defaults.py), the bench's pid-tuned gains (K_P 2365, K_V 1311,
+#: K_I 13.65) gave 0.37 deg RMS, 2.3 deg max, and K_V 300 2.2 deg RMS, 11.9 max, against 0.031 /
+#: 0.19 and 0.025 / 0.088 at the edge step
+LONG_STEP_GAINS_OF = ("paper2010",)
+#: the PID gains of a joint set, named as in the set (per rad)
+GAIN_FIELDS = ("K_P_per_rad", "K_V_s_per_rad", "K_I_per_rad_s")
 #: the closed-loop controllers the edge step was validated with (None: the paper's PID).
 #: fuzzy-pid: 0.106 deg RMS, 0.49 max on the co-operative full cycle (rk4 at 1 ms: 0.018, 0.083);
 #: resistance: its loop hunts, rk4 at 1 ms is 0.18 deg RMS, 1.1 max from rk4 at 0.1 ms itself
@@ -92,7 +103,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
       heating of ``paper2010-table2`` gave 1.2 deg RMS, 6.7 deg max at the long step), the
       paper's PWM-PID or the sliding-mode controller (``controller`` None or one of
       :data:`LONG_STEP_CONTROLLERS`, a prepared
-      :class:`~smafinger.control.params.ControllerParameters`; its gains are not checked) or
+      :class:`~smafinger.control.params.ControllerParameters`) at the set's own gains, those of
+      :data:`LONG_STEP_GAINS_OF` (:func:`_other_gains`; other gains get the edge step), or
       open loop;
     - the algebraic stress law in open loop: the linear rig (whole-wire heating, 0.04 mm RMS,
       0.5 mm max over an 18 mm stroke) and the authors' 2020 joint with the memory rule (0.013
@@ -124,6 +136,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
                     "full cycle)")
         if controller is not None and controller.label not in LONG_STEP_CONTROLLERS:
             return f"controller {controller.label}: not validated at long steps"
+        if program is None and (other := _other_gains(params, controller)) is not None:
+            return other
     if params.pwm_period_s > LONG_STEP_DT_S:
         return f"pwm_period_s = {params.pwm_period_s:g} is longer than the long step ({LONG_STEP_DT_S:g} s)"
     if opts.stress_law == StressLaw.ALGEBRAIC and program is not None and len(program.steps) > 1:
@@ -131,6 +145,26 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
         if gap < PROGRAM_MIN_STEP_S:
             return (f"the drive program has steps {gap:g} s apart (the long step needs {PROGRAM_MIN_STEP_S:g} s or "
                     "more with the algebraic stress law)")
+    return None
+
+
+def _other_gains(params, controller) -> str | None:
+    """Why the closed loop's gains are not those the long step was validated with (None: they are).
+
+    Validated: the controller with every field at its default (derived from the set), on a set
+    whose PID gains are those of one of :data:`LONG_STEP_GAINS_OF`.
+    """
+    from ..parameters import get
+
+    given = [] if controller is None else [f.name for f in dataclasses.fields(controller)
+                                           if "range" in f.metadata and getattr(controller, f.name) != f.default]
+    if given:
+        return (f"controller {controller.label} with {', '.join(given)} given: the long step was validated with "
+                "the set's own gains only")
+    gains = tuple(getattr(params, f) for f in GAIN_FIELDS)
+    if not any(gains == tuple(getattr(get(name), f) for f in GAIN_FIELDS) for name in LONG_STEP_GAINS_OF):
+        return (f"PID gains {', '.join(f'{f} = {g:g}' for f, g in zip(GAIN_FIELDS, gains))}: the long step was "
+                f"validated with those of {', '.join(LONG_STEP_GAINS_OF)} only")
     return None
 
 
