@@ -28,7 +28,7 @@ from ..jit import njit
 from ..parameters.options import IntegralReset
 from .controller import integrating_flag, phase_commands
 from .fuzzy import FuzzyPID, fuzzy_output
-from .pid import pid_output
+from .pid import FULL_DUTY, pid_output
 from .rapid import RapidHeating, shape_commands
 from .selfsensing import ResistanceMap, estimate, filtered_rate
 from .sensing import Sensors, measure
@@ -92,6 +92,15 @@ def law_output(ctrl, e, de, integral):
 
 
 @njit(cache=True, forceinline=True)
+def law_limit(ctrl):
+    """The DC% at which the law's output stops growing (anti-windup's saturation): the switching
+    gain K of the sliding mode (Eq. SM2; the full duty if K is above it), else the full duty."""
+    if ctrl.law == Law.SLIDING_MODE:
+        return min(ctrl.sliding.K, FULL_DUTY)
+    return FULL_DUTY
+
+
+@njit(cache=True, forceinline=True)
 def chain_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
     """One tick of the chain (see the module docstring): (commands, integrating, state)."""
     m = measure(ctrl.sensors, model, s, y, inputs, geom, geom_q, t_s, started)
@@ -104,7 +113,7 @@ def chain_tick(ctrl, cstate, model, s, y, inputs, geom, geom_q, t_s, started):
         q, v, integral = m.q, m.v, m.error_integral
     e = m.q_target - q
     u = law_output(ctrl, e, -v, integral)
-    integrating = integrating_flag(model, u, e)
+    integrating = integrating_flag(model, u, e, law_limit(ctrl))
     cmds = shape_commands(ctrl.shaping, model, phase_commands(model, m.enabled, u, m.q_target, q,
                                                               model.drive.V_H_V), m)
     if ctrl.estimator == Estimator.RESISTANCE:

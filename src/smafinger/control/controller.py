@@ -9,7 +9,7 @@ wire its drive level and duty. Both return a tuple of
 from ..engine.tuples import filled, set_item
 from ..jit import njit
 from ..parameters.options import AntiWindup, DampingSwitch
-from .pid import pid_output, saturated_against
+from .pid import FULL_DUTY, pid_output, saturated_against
 from .strategies import Command, is_enabled, wire_command
 
 
@@ -31,9 +31,10 @@ def phase_commands(model, enabled, u, q_target, q, level):
 
 
 @njit(cache=True, forceinline=True)
-def integrating_flag(model, u, e):
-    """1.0 while the error integral runs, 0.0 while anti-windup freezes it (Eq. 12a)."""
-    frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e)
+def integrating_flag(model, u, e, limit):
+    """1.0 while the error integral runs, 0.0 while anti-windup freezes it (Eq. 12a): the law's
+    output ``u`` is at ``limit`` (DC%; the full duty, 100, for the PID) and the error pushes it further."""
+    frozen = model.options.anti_windup == AntiWindup.CLAMP and saturated_against(u, e, limit)
     return 0.0 if frozen else 1.0
 
 
@@ -46,7 +47,7 @@ def pid_commands(model, enabled, q_target, state, level):
     c = model.controller
     e = q_target - state.q
     u = pid_output(e, -state.v, state.error_integral, c.K_P, c.K_V, c.K_I)
-    return phase_commands(model, enabled, u, q_target, state.q, level), integrating_flag(model, u, e)
+    return phase_commands(model, enabled, u, q_target, state.q, level), integrating_flag(model, u, e, FULL_DUTY)
 
 
 @njit(cache=True, forceinline=True)

@@ -12,6 +12,9 @@ opposite sign (the paper's antagonist, -DC%).
 
 from ..jit import njit
 
+#: the full duty [DC%]: the PID's output saturates here
+FULL_DUTY = 100.0
+
 
 @njit(cache=True, forceinline=True)
 def pid_output(error, error_rate, error_integral, K_P, K_V, K_I):
@@ -26,9 +29,10 @@ def clamp_duty(u):
 
 
 @njit(cache=True, forceinline=True)
-def saturated_against(u, error):
-    """Anti-windup (conditional integration): the output is saturated and the error pushes it further."""
-    return (u >= 100.0 and error > 0.0) or (u <= -100.0 and error < 0.0)
+def saturated_against(u, error, limit):
+    """Anti-windup (conditional integration): the output is at its limit (``|u| >= limit``, DC%)
+    and the error pushes it further."""
+    return (u >= limit and error > 0.0) or (u <= -limit and error < 0.0)
 
 
 @njit(cache=True, forceinline=True)

@@ -14,7 +14,8 @@ variable-structure control of SMA actuators: Grant and Hayward, "Variable struct
 shape memory alloy actuators", IEEE Control Systems 17(3):80-88, 1997; Elahinia and
 Ashrafiuon, "Nonlinear control of a shape memory alloy actuated manipulator", ASME J. Vib.
 Acoust. 124(4):566-575, 2002 (the paper's refs. 12 and 25 are of this family). The integral is
-the plant state's error integral (reset per segment like the PID's, frozen by anti-windup).
+the plant state's error integral (reset per segment like the PID's, frozen by anti-windup
+while the output is at +-K and the error pushes it further: :func:`.chain.law_limit`).
 """
 
 from typing import NamedTuple

@@ -33,7 +33,7 @@ from numba import types
 from numba.extending import overload
 
 from ..control.controller import integrating_flag, phase_commands
-from ..control.pid import on_time, pid_output
+from ..control.pid import FULL_DUTY, on_time, pid_output
 from ..control.strategies import Strategy
 from ..jit import njit
 from ..model.heat import wire_temperature_rate
@@ -98,7 +98,7 @@ def _pid_rate(ctrl, model, enabled, q_target, y, cmds, integrating, error_rate):
     e = q_target - y.q
     u = pid_output(e, error_rate, y.error_integral, ctrl.K_P, ctrl.K_V, ctrl.K_I)
     return (phase_commands(model, enabled, u, q_target, y.q, model.drive.V_H_V),
-            integrating_flag(model, u, e))
+            integrating_flag(model, u, e, FULL_DUTY))
 
 
 @njit(cache=True, forceinline=True)
