@@ -77,6 +77,24 @@ def test_the_limit_is_half_the_memory_and_is_applied(monkeypatch):
     make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0)
 
 
+@pytest.mark.parametrize("t_end_s, interval_s", [(10.0, 3.0), (14.0, 0.0015), (1.0, 0.3)])
+def test_an_output_grid_that_misses_the_end_is_refused(t_end_s, interval_s):
+    """The totals and the last segment are read at the last sample: 3 s samples over 10 s gave the
+    energy at 9 s as the run's (42.2 J against 52.7 J; found by review). Refused, the message
+    naming both values and the end times that would do."""
+    with pytest.raises(ValueError) as info:
+        make_spec("linear-bias-spring", "open-loop", voltage="0:0,0.5:0.3", drive="duty", t_end_s=t_end_s,
+                  output_interval_s=interval_s)
+    msg = str(info.value)
+    assert f"t_end_s = {t_end_s!r}" in msg and f"output_interval_s = {interval_s!r}" in msg and "\n" not in msg
+    below = float(msg.split("t_end_s = ")[-1].split(" or ")[0])
+    above = float(msg.split(" or ")[-1].split(" would")[0])
+    for end in (below, above):
+        assert len(make_spec("paper2010", "cooperative", "0:-25", t_end_s=end,
+                             output_interval_s=interval_s).profile.segments) == 1
+        assert end == pytest.approx(round(end / interval_s) * interval_s) and abs(end - t_end_s) < interval_s
+
+
 # ---- argument types --------------------------------------------------------------------------
 @pytest.mark.parametrize("kw, message", [
     (dict(profile=[(0, -25)]), "profile = [(0, -25)] is not a profile text"),
@@ -114,13 +132,25 @@ def test_whole_numbers_as_parameter_values_run(tmp_path):
     assert r.metrics["energy_J"]["upper"] > 0
 
 
-@pytest.mark.parametrize("profile, t_end, every", [("0:-20,0.25:-20,0.375:-20", 1.0, 0.5),  # between samples
-                                                   ("0:-25,0.95:-30", 1.0, 0.3)])  # after the last sample
+@pytest.mark.parametrize("profile, t_end, every", [("0:-20,0.25:-20,0.375:-20", 1.0, 0.5)])  # between samples
 def test_segments_without_an_output_sample_have_no_peaks_instead_of_crashing(profile, t_end, every):
     """Found by the long fuzz: a segment shorter than the output interval made the metrics
-    take the maximum of nothing (or index past the last sample)."""
+    take the maximum of nothing (or index past the last sample, which no longer happens: the
+    output grid ends at t_end, test_an_output_grid_that_misses_the_end_is_refused)."""
     r = simulate("paper2010", "independent", profile, t_end_s=t_end, output_interval_s=every)
     empty = [s for s in r.metrics["segments"] if s["peak_temperature_C"]["upper"] is None]
     assert empty and all(s["energy_J"] == {"upper": None, "lower": None} for s in empty)
     full = [s for s in r.metrics["segments"] if s not in empty]
     assert all(isinstance(s["peak_temperature_C"]["upper"], float) for s in full)
+
+
+@pytest.mark.parametrize("params, kw, message", [
+    ("linear-bias-spring", dict(profile="0:0.01", tol_deg=5.0), "tol_deg = 5.0 does not apply to linear-bias-spring"),
+    ("paper2010", dict(profile="0:-25", tol_m=1e-3), "tol_m = 0.001 does not apply to paper2010"),
+])
+def test_a_tolerance_in_the_other_mechanisms_unit_is_refused(params, kw, message):
+    """``--tol-deg 5`` on the linear rig ran with its 0.5 mm and no word (found by review)."""
+    with pytest.raises(ValueError, match=message):
+        make_spec(params, "cooperative", t_end_s=1.0, **kw)
+    unit = "tol_m" if "tol_deg" in kw else "tol_deg"
+    assert make_spec(params, "cooperative", t_end_s=1.0, profile=kw["profile"], **{unit: 1e-3}).tolerance == 1e-3

@@ -12,7 +12,7 @@ from __future__ import annotations
 # the engine's defaults and identification's: one copy, in a module that loads no numba
 from ..engine.defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, LONG_STEP_DT_S,  # noqa: F401
                                LONG_STEP_METHOD, LONG_STEP_PWM, LONG_STEP_STIFF_METHOD,
-                               DEFAULT_TOL_M, ENGINE_ENV, ENGINES, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED)
+                               DEFAULT_TOL_DEG, DEFAULT_TOL_M, ENGINE_ENV, ENGINES, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED)
 
 #: control strategies (``control.strategies.STRATEGIES``)
 STRATEGY_NAMES = ("open-loop", "independent", "cooperative")

@@ -8,8 +8,8 @@ from typing import List, Optional
 
 import typer
 
-from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINE_ENV,
-                      LONG_STEP_DT_S, LONG_STEP_METHOD, LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
+from .choices import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG, DEFAULT_TOL_M,
+                      ENGINE_ENV, LONG_STEP_DT_S, LONG_STEP_METHOD, LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
 from .common import Engine, Method, Pwm, Strategy, given, load_params, progress_display, progress_option, refuse
 from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
@@ -61,7 +61,7 @@ def simulate(
     pwm: Optional[Pwm] = typer.Option(None, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
                                                           "averaged power (averaged: long steps) [default: see --method]"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
-    tol_deg: float = typer.Option(0.5, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
+    tol_deg: float = typer.Option(DEFAULT_TOL_DEG, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
     tol_m: float = typer.Option(DEFAULT_TOL_M, "--tol-m", metavar="M", help="target tolerance of a linear actuator [m]"),
     hold_s: float = typer.Option(0.5, "--hold-s", metavar="S", help="time a target must hold within tolerance [s]"),
     out: Optional[Path] = typer.Option(None, "--out", metavar="FILE",

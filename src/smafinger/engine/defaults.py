@@ -31,6 +31,8 @@ ENGINE_ENV = "SMAFINGER_ENGINE"
 
 #: default target tolerance of the linear actuator [m]
 DEFAULT_TOL_M = 5e-4
+#: default target tolerance of the finger joint [deg]
+DEFAULT_TOL_DEG = 0.5
 
 #: identification's two stages (analysis.actuator_fit.FitSettings): the global stage's budget
 #: of candidate sets, the least-squares stage's iterations, CMA-ES's seed

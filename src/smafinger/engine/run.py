@@ -23,7 +23,7 @@ from .compiled import INTERPRETED, kernels
 from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
-from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_M, ENGINES  # noqa: F401
+from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG, DEFAULT_TOL_M, ENGINES  # noqa: F401
 from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, WIRE_FIELDS, check_recorded, every_signal, new_outputs
 
 
@@ -59,7 +59,7 @@ class RunSpec:
 
 def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=None,
               t_end_s=20.0, dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S,
-              tol_deg=0.5, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage",
+              tol_deg=DEFAULT_TOL_DEG, hold_s=0.5, independent_wait=True, tol_m=DEFAULT_TOL_M, drive="voltage",
               pwm=None, controller=None) -> RunSpec:
     """A validated :class:`RunSpec` (see :func:`simulate` for the arguments).
 
@@ -92,6 +92,7 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     for name, v in (("tol_deg", tol_deg), ("tol_m", tol_m), ("hold_s", hold_s)):
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
+    _check_tolerance_unit(p, tol_deg, tol_m)
     if controller is not None:
         controller = controller_from(controller).prepared(p)
         if strategy == "open-loop":
@@ -212,6 +213,26 @@ def _program(spec: RunSpec, model) -> Program:
     return Program(ticks_array(f"{prog.kind} start", cols[0]), level, duty)
 
 
+def _check_tolerance_unit(p: ParameterSet, tol_deg: float, tol_m: float) -> None:
+    """A tolerance in the other mechanism's unit would be ignored (``tol_deg`` on a slider)."""
+    unused, value, default = (("tol_m", tol_m, DEFAULT_TOL_M) if p.coordinate.unit == "deg"
+                              else ("tol_deg", tol_deg, DEFAULT_TOL_DEG))
+    if value != default:
+        used = "tol_deg" if unused == "tol_m" else "tol_m"
+        raise ValueError(f"{unused} = {value!r} does not apply to {p.name}, whose targets are in {p.coordinate.unit}: "
+                         f"give {used}")
+
+
+def _check_output_grid(spec: RunSpec, run) -> None:
+    """The output grid must end at t_end: the totals and the last segment's metrics are read at the
+    last sample (with 3 s over 10 s the run's energy was the energy at 9 s)."""
+    if run.t_end_ticks % run.out_ticks:
+        below = run.t_end_ticks // run.out_ticks * run.out_ticks * TICK_S
+        raise ValueError(f"t_end_s = {spec.t_end_s!r} is not a whole multiple of output_interval_s = "
+                         f"{spec.output_interval_s!r}: the last sample would be at {below:.9g} s, not at the end "
+                         f"(t_end_s = {below:.9g} or {below + run.out_ticks * TICK_S:.9g} would do)")
+
+
 def kernel_args(spec: RunSpec, record: str = "all") -> dict:
     """The records and arrays the kernel takes (validated); ``record``: see :func:`run_spec`."""
     t_end = to_ticks("t_end_s", spec.t_end_s)
@@ -231,6 +252,7 @@ def kernel_args(spec: RunSpec, record: str = "all") -> dict:
         tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
         pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm),
         every_signal=every_signal(record))
+    _check_output_grid(spec, run)
     _check_output_size(spec, run)
     model = build_model(p)
     if spec.controller is not None:
@@ -346,7 +368,7 @@ def _run_with_progress(call, mech, t_end_s, progress):
 
 
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
-             dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=0.5,
+             dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=DEFAULT_TOL_DEG,
              hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
              pwm=None, controller=None, engine=None):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
