@@ -270,14 +270,32 @@ def test_a_target_never_pursued_is_said_and_has_no_overshoot():
 
 def test_a_segment_without_samples_is_shown_and_tabled_without_an_overshoot(capsys):
     """Its overshoot of None reached the terminal table's format and a sweep row's float(): both
-    raised TypeError (the CLI fuzzer: a segment starting at t_end). The table shows '-', the row NaN."""
+    raised TypeError (the CLI fuzzer: a segment starting between the last sample and t_end, which
+    the output grid now refuses; here a target never pursued). The table shows '-', the row NaN."""
     from smafinger.analysis.sweep_rows import metrics_row
     from smafinger.cli.show import print_run
 
-    r = simulate("paper2010", "independent", "0:-20,1.8125:-20", t_end_s=1.8125)
+    r = simulate("paper2010", "cooperative", "0:-25,reach:-55,3:-40", t_end_s=12.0)
     assert r.summary()["segments"][1]["overshoot_deg"] is None
     print_run(r)
-    last = [line for line in capsys.readouterr().out.splitlines() if line.strip().startswith("│ ")][-1]
-    assert last.split("│")[1:-1][-1].strip() == "-" and last.split("│")[1].strip() == "1"
+    rows = [[c.strip() for c in line.split("│")[1:-1]] for line in capsys.readouterr().out.splitlines()
+            if line.strip().startswith("│ ")]
+    assert [row[-1] == "-" for row in rows if row[0] in "012"] == [False, True, False]
     row = metrics_row(r)
     assert math.isnan(row["seg1_overshoot_deg"]) and row["seg0_overshoot_deg"] >= 0.0
+
+
+def test_an_open_loop_run_reports_no_reach_and_no_overshoot():
+    """An open-loop run's one segment holds the rest position with no wire enabled: its target was
+    reported reached after one step and its overshoot as 0.0 while the slider went 17.9 mm out
+    (found by review); the same values became a sweep's seg0_* columns. Now None (NaN in a row)."""
+    from smafinger.analysis.sweep_rows import metrics_row
+
+    r = simulate("linear-bias-spring", "open-loop", voltage="0:0,2:0.3", drive="duty", t_end_s=6.0)
+    (seg,) = r.summary()["segments"]
+    assert seg["reached_s"] is None and seg["overshoot_m"] is None
+    assert seg["energy_J"]["wire"] > 0 and np.ptp(r.position_m) > 0.005
+    row = metrics_row(r)
+    assert math.isnan(row["seg0_reached_s"]) and math.isnan(row["seg0_overshoot_m"])
+    closed = simulate("linear-bias-spring", "cooperative", "0:0.004", t_end_s=6.0).summary()["segments"][0]
+    assert closed["reached_s"] is not None and closed["overshoot_m"] is not None

@@ -314,6 +314,8 @@ class Span:
     target: float
     enable: str
     reached_s: float | None
+    #: a target a controller pursued (False: an open-loop run's placeholder, with no overshoot)
+    pursued: bool = True
 
 
 def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
@@ -338,7 +340,7 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
         f"target_{unit}": span.target,
         "enable": span.enable,
         "reached_s": span.reached_s,
-        f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction) if some else None,
+        f"overshoot_{unit}": overshoot_deg(q[m], span.target, direction) if some and span.pursued else None,
         "energy_J": electrical,
         "electrical_energy_J": electrical,
         **({"heat_J": {w: increase(t, e, span.start_s, span.end_s) if some else None for w, e in heat_J.items()}}

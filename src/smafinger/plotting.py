@@ -38,7 +38,8 @@ def plot_result(result, path: str | Path | None = None, title: str | None = None
     t = result.t
     fig, ax = plt.subplots(5, 1, figsize=(7.5, 10.5), sharex=True, constrained_layout=True)
     ax[0].plot(t, k * result.signal(q), color="k", label=sym)
-    ax[0].plot(t, k * result.signal(q_ref), color="tab:red", ls="--", lw=1.0, label="target")
+    if result.spec.strategy != "open-loop":  # open loop pursues no target
+        ax[0].plot(t, k * result.signal(q_ref), color="tab:red", ls="--", lw=1.0, label="target")
     ax[0].set_ylabel(q_label)
     ax[0].legend(loc="best", fontsize=8)
     ax[1].plot(t, k * result.signal(v), color="k")

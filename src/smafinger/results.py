@@ -187,10 +187,14 @@ def compute_metrics(result: SimulationResult) -> dict:
     unit = p.coordinate.unit
     wires = p.wire_names
     spans = []
+    # open loop: the one segment holds the rest position with no wire enabled, a target no one
+    # pursues (its "reach" was the first step, its overshoot 0 whatever the drive did)
+    pursued = spec.strategy != "open-loop"
     for i, start, end in segment_bounds(result):
         seg = spec.profile.segments[i]
         reached = result.segment_reached_s[i]
-        spans.append(Span(i, start, end, seg.target, seg.enable, None if math.isnan(reached) else float(reached)))
+        spans.append(Span(i, start, end, seg.target, seg.enable,
+                          None if math.isnan(reached) or not pursued else float(reached), pursued))
     m = run_metrics(result.t, result.signal(f"{p.coordinate.name}_{unit}"), spans,
                     temperature_C={w: result.signal(f"T_{w}_C") for w in wires},
                     stress_Pa={w: result.signal(f"sigma_{w}_Pa") for w in wires},
