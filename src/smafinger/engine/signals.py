@@ -46,8 +46,11 @@ SIGNALS: tuple[Signal, ...] = (
     Signal("spring", True, "m", "spring_{wire}_m", mechanisms=("joint",), doc="tendon spring elongation"),
     Signal("V", True, "V", "V_{wire}_V", doc="the drive at the sample: with the exact PWM the level applied then "
            "(V_H in the on part of a period, V_L in the off part); with the averaged PWM the period's RMS, "
-           "sqrt(d V_H^2 + (1 - d) V_L^2) (pwm.averaged_drive), so V^2 / R is the mean power either way; "
-           "a current in A with a current drive"),
+           "sqrt(d V_H^2 + (1 - d) V_L^2) (pwm.averaged_drive), whose square over the heating resistance "
+           "R_w L_w is the period's mean power (R_{wire}_ohm is the phase-dependent resistance a sensor "
+           "reads, not that one). With the exact PWM, samples on the period grid all fall in the on "
+           "part: read the mean power as the slope of electrical_energy_{wire}_J. A current in A with a "
+           "current drive"),
     Signal("duty", True, "%", "duty_{wire}", doc="PWM duty DC% (Eq. 12)"),
     # --- added in smafinger 0.2 -------------------------------------------------------------
     Signal("electrical", True, "J", "electrical_energy_{wire}_J",
