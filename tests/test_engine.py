@@ -238,3 +238,14 @@ def test_long_pwm_voltage_program_matches_item_by_item_parse():
     assert ticks_array("voltage start", starts).tolist() == [to_ticks("t", t, True) for t in starts]
     with pytest.raises(ValueError, match=r"voltage start \[1\] = 1e-10 s is not a whole number"):
         ticks_array("voltage start", np.array([0.0, 1e-10]))
+
+
+def test_a_low_level_that_heats_both_wires_is_warned_of():
+    """V_L > 0 drives both joint wires whenever neither is pulsed: with no wire enabled both went
+    to 99.8 degC and transformed, with 0 interlock violations and no warning (found by review)."""
+    from smafinger.parameters import get as get_set
+
+    hot = simulate(get_set("paper2010").replace(V_L_V=6.0), "cooperative", "0:-40:none", t_end_s=5.0, method="rk4")
+    assert (hot.V_upper_V == 6.0).all() and (hot.V_lower_V == 6.0).all() and hot.interlock_violations == 0
+    assert [w for w in hot.summary()["warnings"] if w.startswith("V_L_V = 6 V drives every wire")]
+    assert not simulate("paper2010", "cooperative", "0:-40:none", t_end_s=5.0, method="rk4").summary()["warnings"]

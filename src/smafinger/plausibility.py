@@ -74,6 +74,10 @@ def check(result) -> list[str]:
             out.append(f"{w} wire: strain {strain:.3g} at t = {at:.3g} s, beyond the recoverable strain "
                        f"eps_R = {p.eps_R:g} (+{STRAIN_MARGIN:g}): the wire would deform plastically, "
                        "which the model does not describe")
+    if p.V_L_V > 0.0 and len(p.wire_names) > 1:  # the joint's two wires pull against each other
+        out.append(f"V_L_V = {p.V_L_V:g} V drives every wire whose duty is 0 (Fig. 6's low level): the opposing "
+                   "wires are heated at once whenever one is not pulsed, which the interlock counter, counting "
+                   "drives above V_L, does not count")
     return out
 
 
