@@ -15,7 +15,13 @@ hard each wire should heat, and mechanisms around it make the heating fast but s
 - Pre-heating the antagonist: an enabled wire the core leaves idle is heated at
   ``preheat_duty`` towards ``preheat_C`` (below its A_s: it gets warm, it does not contract),
   so that it starts pulling sooner when its turn comes; only while no opposing wire is driven,
-  so the interlock (two opposing wires never heated at once, Sec. 2.6) holds.
+  so the interlock (two opposing wires never heated at once, Sec. 2.6) holds. Teh and
+  Featherstone pre-heat the antagonist while the agonist works, which that interlock forbids, so
+  here it does little: under the co-operative strategy with the controller on in cooling one of
+  the two wires always has a duty, and the run is bit-identical with and without it (the full
+  cycle, rk4 at 1 ms, ``preheat_C`` 60, 80 %); under the independent strategy only the agonist is
+  enabled, so it is the idle agonist that is kept warm between moves: the same motion within
+  2e-8 deg, 113.1 J in the upper wire against 90.2 J.
 
 Teh and Featherstone also keep a minimum tension in both wires (anti-slack). The finger's
 spring-slack tendons are pre-tensioned by their bias springs, so neither tendon goes slack in
