@@ -8,7 +8,6 @@ of workers.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Callable, Sequence
@@ -95,16 +94,16 @@ def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
 
 def warm_kernels(specs) -> None:
     """Compile (or load) the loop once here for each kind of run among ``specs`` (mechanism and
-    controller record type: a 2 ms run), so that the workers load it from numba's cache instead of
-    each compiling it at once."""
-    from ..engine.run import kernel_args, run_spec
+    controller record type), so that the workers load it from numba's cache instead of each
+    compiling it at once."""
+    from ..engine.run import compile_kernel, kernel_key
 
     seen = set()
     for spec in specs:
-        key = (spec.params.mechanism, type(kernel_args(spec)["model"].controller))
+        key = kernel_key(spec)
         if key not in seen:
             seen.add(key)
-            run_spec(dataclasses.replace(spec, t_end_s=0.002, profile=spec.profile))
+            compile_kernel(spec)
 
 
 def bandwidth_table(rows: pd.DataFrame, tasks: Sequence[Task]) -> pd.DataFrame:
