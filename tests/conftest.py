@@ -33,3 +33,34 @@ def data_dir():
         return path
 
     return get
+
+
+#: one run of each compiled kernel the suite uses (engine.run.kernel_key: mechanism and controller
+#: record type), as make_spec arguments
+KERNELS = (
+    dict(params="paper2010", strategy="cooperative", profile="0:-25"),
+    dict(params="paper2010", strategy="cooperative", profile="0:-25", controller="sliding-mode"),
+    dict(params="linear-bias-spring", strategy="cooperative", profile="0:0.01"),
+    dict(params="linear-bias-spring", strategy="cooperative", profile="0:0.01", controller="sliding-mode"),
+)
+
+
+def pytest_sessionstart(session):
+    """Compile the kernels not in numba's cache yet, two processes at once (this machine's cores),
+    before the first test: a fresh checkout otherwise compiles them one after the other, in
+    whichever test first needs each (about a minute each). Tests are unchanged: with the cache
+    warm this only looks the kernels up."""
+    import subprocess
+    import sys
+
+    from smafinger.engine.run import kernel_cached, make_spec
+
+    missing = [kw for kw in KERNELS if not kernel_cached(make_spec(t_end_s=0.01, **kw))]
+    if len(missing) < 2:
+        return  # one compile: the test that needs it does it
+    code = ("import sys, json; from smafinger.engine.run import compile_kernel, make_spec\n"
+            "for kw in json.loads(sys.argv[1]): compile_kernel(make_spec(t_end_s=0.01, **kw))")
+    import json
+    procs = [subprocess.Popen([sys.executable, "-c", code, json.dumps(missing[i::2])]) for i in range(2)]
+    for proc in procs:
+        proc.wait()
