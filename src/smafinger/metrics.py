@@ -326,7 +326,9 @@ def segment_metrics(t: np.ndarray, q: np.ndarray, span: Span,
     and ``heat_J`` (cumulative heat the model puts into each wire) are signals; the segment's
     electrical energy is given as ``electrical_energy_J`` (and as ``energy_J``, its 0.1 name),
     its heat as ``heat_J``. ``q`` is the joint angle [deg] or a slider's position [m]; ``unit``
-    names the keys (``target_deg``, ``overshoot_m``)."""
+    names the keys (``target_deg``, ``overshoot_m``). Everything but the span's own times is read
+    from the samples: with a coarse output interval the energy between the segment's start and the
+    next sample is credited to the segment before it."""
     m = window_slice(t, span.start_s, span.end_s)  # t: a run's output times, ascending
     # None: no output sample falls in the segment (it is shorter than the output interval)
     some = m.stop > m.start
