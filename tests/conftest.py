@@ -1,4 +1,7 @@
+import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -50,9 +53,6 @@ def pytest_sessionstart(session):
     before the first test: a fresh checkout otherwise compiles them one after the other, in
     whichever test first needs each (about a minute each). Tests are unchanged: with the cache
     warm this only looks the kernels up."""
-    import subprocess
-    import sys
-
     from smafinger.engine.run import kernel_cached, make_spec
 
     missing = [kw for kw in KERNELS if not kernel_cached(make_spec(t_end_s=0.01, **kw))]
@@ -60,7 +60,50 @@ def pytest_sessionstart(session):
         return  # one compile: the test that needs it does it
     code = ("import sys, json; from smafinger.engine.run import compile_kernel, make_spec\n"
             "for kw in json.loads(sys.argv[1]): compile_kernel(make_spec(t_end_s=0.01, **kw))")
-    import json
     procs = [subprocess.Popen([sys.executable, "-c", code, json.dumps(missing[i::2])]) for i in range(2)]
     for proc in procs:
         proc.wait()
+
+
+#: the test that reads :class:`FreshInstall`
+FRESH_INSTALL_TEST = "test_a_fresh_install_answers_interpreted_then_compiles_in_the_background"
+
+
+class FreshInstall:
+    """``smafinger simulate`` of the linear rig with an empty numba cache of its own (a fresh
+    install), started once the tests are collected if the fresh-install test is among them: the
+    first run answers interpreted and starts the background compile (a minute or more), which
+    then overlaps the tests run before that one checks it."""
+
+    args = ("simulate", "--params", "linear-bias-spring", "--profile", "0:0.010", "--t-end", "3", "--no-progress")
+
+    def __init__(self, root: Path):
+        self.root = root
+        self.env = {k: v for k, v in os.environ.items() if k != "SMAFINGER_ENGINE"}
+        self.env["NUMBA_CACHE_DIR"] = str(root / "cache")
+        with open(root / "first.out", "w") as out, open(root / "first.err", "w") as err:
+            self.first = subprocess.Popen(self.command(root / "run0.json"), env=self.env, cwd=root, stdout=out,
+                                          stderr=err)
+
+    def command(self, summary: Path) -> list[str]:
+        return [sys.executable, "-m", "smafinger.cli", *self.args, "--summary", str(summary)]
+
+    def first_run(self, timeout_s: float) -> tuple[int, str]:
+        """The first run's exit status and stderr, once it has ended."""
+        rc = self.first.wait(timeout=timeout_s)
+        return rc, (self.root / "first.err").read_text()
+
+
+@pytest.hookimpl(trylast=True)  # after -k and -m have deselected
+def pytest_collection_modifyitems(session, config, items):
+    if any(item.name == FRESH_INSTALL_TEST for item in items):
+        config.fresh_install = FreshInstall(config._tmp_path_factory.mktemp("fresh-install"))  # tmp_path_factory's
+
+
+@pytest.fixture(scope="session")
+def fresh_install(pytestconfig):
+    probe = pytestconfig.fresh_install
+    yield probe
+    if probe.first.poll() is None:
+        probe.first.kill()
+        probe.first.wait()

@@ -180,29 +180,25 @@ def _wait_for_build(spec, cache_dir):
         fcntl.flock(lock, fcntl.LOCK_EX)
 
 
-def test_a_fresh_install_answers_interpreted_then_compiles_in_the_background(tmp_path):
+def test_a_fresh_install_answers_interpreted_then_compiles_in_the_background(fresh_install):
     """An empty numba cache (a fresh install): the first ``simulate`` is interpreted and says so;
-    the kernel is compiled meanwhile by one background process; the next run loads it."""
-    env = {k: v for k, v in os.environ.items() if k != "SMAFINGER_ENGINE"}
-    env["NUMBA_CACHE_DIR"] = str(tmp_path / "cache")
-    args = [sys.executable, "-m", "smafinger.cli", "simulate", "--params", "linear-bias-spring",
-            "--profile", "0:0.010", "--t-end", "3", "--no-progress"]
+    the kernel is compiled meanwhile by one background process; the next run loads it. The first
+    run is started with the session (conftest.FreshInstall), so its compile overlaps other tests."""
+    root, env = fresh_install.root, fresh_install.env
     spec = make_spec("linear-bias-spring", "cooperative", "0:0.010", t_end_s=3.0)
-    summaries = []
-    for i in range(2):
-        out = tmp_path / f"run{i}.json"
-        proc = subprocess.run([*args, "--summary", str(out)], env=env, capture_output=True, text=True, cwd=tmp_path)
-        assert proc.returncode == 0, proc.stderr
-        summaries.append(json.loads(out.read_text()))
-        if i == 0:
-            assert "this run was interpreted" in proc.stderr and "background" in proc.stderr
-            deadline = time.monotonic() + 600
-            while not _index_has_kernel(tmp_path / "cache") and time.monotonic() < deadline:
-                time.sleep(1.0)
-            assert _index_has_kernel(tmp_path / "cache"), "the background compile left no kernel in the cache"
-            _wait_for_build(spec, env["NUMBA_CACHE_DIR"])  # numba writes the index, then the kernel
-        else:
-            assert "interpreted" not in proc.stderr
+    rc, stderr = fresh_install.first_run(timeout_s=600)
+    assert rc == 0, stderr
+    assert "this run was interpreted" in stderr and "background" in stderr
+    deadline = time.monotonic() + 600
+    while not _index_has_kernel(root / "cache") and time.monotonic() < deadline:
+        time.sleep(1.0)
+    assert _index_has_kernel(root / "cache"), "the background compile left no kernel in the cache"
+    _wait_for_build(spec, env["NUMBA_CACHE_DIR"])  # numba writes the index, then the kernel
+    proc = subprocess.run(fresh_install.command(root / "run1.json"), env=env, capture_output=True, text=True,
+                          cwd=root)
+    assert proc.returncode == 0, proc.stderr
+    assert "interpreted" not in proc.stderr
+    summaries = [json.loads((root / f"run{i}.json").read_text()) for i in range(2)]
     assert [s["engine"] for s in summaries] == ["interpreted", "compiled"]
     assert summaries[0]["segments"][0]["reached_s"] == pytest.approx(summaries[1]["segments"][0]["reached_s"],
                                                                       abs=1e-9)
