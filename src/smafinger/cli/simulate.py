@@ -61,7 +61,8 @@ def simulate(
     pwm: Optional[Pwm] = typer.Option(None, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
                                                           "averaged power (averaged: long steps) [default: see --method]"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
-    tol_deg: float = typer.Option(DEFAULT_TOL_DEG, "--tol-deg", metavar="DEG", help="target tolerance of the joint [deg]"),
+    tol_deg: float = typer.Option(DEFAULT_TOL_DEG, "--tol-deg", metavar="DEG",
+                                  help="target tolerance of the joint [deg]"),
     tol_m: float = typer.Option(DEFAULT_TOL_M, "--tol-m", metavar="M", help="target tolerance of a linear actuator [m]"),
     hold_s: float = typer.Option(0.5, "--hold-s", metavar="S", help="time a target must hold within tolerance [s]"),
     out: Optional[Path] = typer.Option(None, "--out", metavar="FILE",

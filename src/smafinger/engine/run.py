@@ -23,7 +23,8 @@ from .compiled import INTERPRETED, kernels
 from .kernel import Program, RunSettings, memory_stacks
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
-from .defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG, DEFAULT_TOL_M, ENGINES  # noqa: F401
+from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG,  # noqa: F401
+                       DEFAULT_TOL_M, ENGINES)
 from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, WIRE_FIELDS, check_recorded, every_signal, new_outputs
 
 
