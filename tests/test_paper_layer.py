@@ -277,3 +277,27 @@ def test_open_loop_scenarios_drive_at_the_runs_own_v_h(name):
     assert levels == {base.params.V_H_V}
     four = s.spec(overrides=["V_H_V=4"])
     assert four.params.V_H_V == 4.0 and {v for step in four.voltage.steps for v in step[1:] if v} == {4.0}
+
+
+def test_the_h2_claim_is_not_shown_without_h0s_runs():
+    """Its third check ("h2 changes the range less than h0 does") passed when h0's runs were not
+    selected, and the report then said the known gap "should go" (found by review)."""
+    from smafinger.paper import scenarios
+
+    claim = next(c for c in scenarios.claims() if c.key == "h2-upper")
+    v = {"range_deg": [18.0, 16.0, 14.0], "start_s": [4.0, 5.0, 6.0], "h0_spread_deg": None}
+    assert [c.test(v) for c in claim.checks] == [True, True, False]
+    assert [c.test({**v, "h0_spread_deg": 5.0}) for c in claim.checks] == [True, True, True]
+
+
+def test_fig13_asks_that_the_antagonist_pulls():
+    """Case 2's faster return came from the damping rule with the antagonist never transforming,
+    and was marked 'yes' (found by review): a check now needs the antagonist to transform."""
+    from smafinger.paper import scenarios
+
+    for key in ("fig13-extension", "fig13-flexion"):
+        claim = next(c for c in scenarios.claims() if c.key == key)
+        v = {"case1": 5.6, "case2": 3.0, "antagonist_xi_min": 1.0}
+        assert [c.test(v) for c in claim.checks] == [True, False]
+        assert [c.test({**v, "antagonist_xi_min": 0.9}) for c in claim.checks] == [True, True]
+        assert "damping" in claim.known_gap

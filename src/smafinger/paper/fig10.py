@@ -93,8 +93,8 @@ CLAIMS = (Claim(
         "about 23 °C, the cooling between cycles is incomplete, and the cooling time of a move grows"),
     paper="stepwise increase from around 23 °C, incomplete cooling", scenarios=(TWO_NODE.name, SINGLE_NODE.name),
     measure=_measure, shows=_shows,
-    checks=(Check(f"the first cycle starts at the ambient {P2010.T_amb_C:g} °C and each next one warmer",
-                  lambda v: v["casing_start_C"][0] == v["T_amb_C"] and increasing(v["casing_start_C"])),
+    checks=(Check(f"each cycle starts warmer than the one before (the first at the ambient {P2010.T_amb_C:g} °C, "
+                  "the initial condition)", lambda v: increasing(v["casing_start_C"])),
             Check("each cool-down ends warmer than its cycle began (incomplete cooling)",
                   lambda v: all(e > s for s, e in zip(v["casing_start_C"], v["casing_end_C"]))),
             Check("the cooling time of the move grows from cycle to cycle",

@@ -180,8 +180,8 @@ CLAIMS = (
           paper="(ii) faster than (i), with overshoot", scenarios=(V1[0].name, V1[1].name),
           measure=_v1_measure, shows=_v1_shows, note=_v1_note, checks=_checks(rate=False),
           known_gap=("with K_P = K_V and the integral reset at the new target the PID output stays negative during "
-                     "the return, so 'on' applies 0 V as 'off' does; the two returns differ by about 1% and a few "
-                     "hundredths of a degree")),
+                     "the return, so 'on' applies 0 V as 'off' does and the two returns nearly coincide (the values "
+                     "beside it)")),
 )
 
 FIGURES = (

@@ -131,8 +131,8 @@ def _moves(v: dict, k: str) -> str:
 
 def _time_claim(strategy: str) -> Claim:
     ref = PAPER_S[strategy]
-    gap = ("with each target issued on reach the cycle takes about half the paper's time under every reading "
-           "tried (report.md's Fig. 15 sections)")
+    gap = ("with each target issued on reach the faithful reading takes about half the paper's time; the other "
+           "readings of report.md's Fig. 15 sections range from about half to about twice it")
     if strategy == "independent":
         gap = ("with each target issued on reach the cycle takes about two thirds of the paper's time (report.md's "
                "Fig. 15 sections)")
@@ -146,6 +146,18 @@ def _time_claim(strategy: str) -> Claim:
                       lambda v: within(v[f"{strategy}_s"], ref, TIME_TOLERANCE)),),
         note=lambda v: f"{pct(None if v[f'{strategy}_s'] is None else v[f'{strategy}_s'] / ref - 1)} vs the paper",
         known_gap=gap)
+
+
+def _last_moves(v: dict) -> str:
+    """On a schedule a cycle is its earlier moves' slots plus its last move: what the time bands test."""
+    parts = []
+    for k in PAPER_S:
+        moves = v[f"{k}_reached_s"] or []
+        slots = (len(moves) - 1) * MOVE_S
+        parts.append(f"{STRATEGY_NAMES[k]} {secs(moves[-1] if moves else None)} (the paper's time implies "
+                     f"{PAPER_S[k] - slots:g} s)")
+    return ("a scheduled cycle is its earlier moves' slots plus its last move, so the time bands test the last "
+            "move: " + ", ".join(parts))
 
 
 def _rel(v: dict) -> str:
@@ -167,10 +179,12 @@ CLAIMS = (
           paper=f"{PAPER_S['independent']:g} s / {PAPER_S['cooperative']:g} s ({pct(PAPER_REDUCTION)})",
           scenarios=tuple(SCHEDULE.values()), measure=_cycles(SCHEDULE),
           shows=lambda v: f"{secs(v['independent_s'])} / {secs(v['cooperative_s'])} ({pct(v['reduction'])})",
-          checks=tuple(Check(f"{STRATEGY_NAMES[k]} cycle within {pct(TIME_TOLERANCE)} of {ref:g} s",
-                             lambda v, k=k, ref=ref: within(v[f"{k}_s"], ref, TIME_TOLERANCE))
-                       for k, ref in PAPER_S.items()),
-          note=lambda v: f"{_rel(v)} vs the paper"),
+          checks=(*(Check(f"{STRATEGY_NAMES[k]} cycle within {pct(TIME_TOLERANCE)} of {ref:g} s",
+                          lambda v, k=k, ref=ref: within(v[f"{k}_s"], ref, TIME_TOLERANCE))
+                    for k, ref in PAPER_S.items()),
+                  Check(f"reduction within the acceptance band {pct(REDUCTION_BAND[0])}-{pct(REDUCTION_BAND[1])}",
+                        lambda v: between(v["reduction"], *REDUCTION_BAND))),
+          note=lambda v: f"{_rel(v)} vs the paper; {_last_moves(v)}"),
 )
 
 FIGURES = (Figure(
