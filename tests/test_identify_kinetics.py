@@ -148,3 +148,32 @@ def test_one_stress_level_holds_the_slopes_and_moduli():
     assert "c_A_Pa_per_C" not in fit.fitted and "D_M_Pa" not in fit.fitted and fit.notes
     assert fit.params.c_A_Pa_per_C == base.c_A_Pa_per_C and fit.params.D_M_Pa == base.D_M_Pa
     assert set(fit.stderr) == set(fit.fitted)
+
+
+def test_a_curve_measured_from_another_reference_is_read_from_its_minimum(real_curves, tmp_path):
+    """The docs promise the strain shifted to a minimum of 0; it was read as written, so 0.003
+    added to every row moved A_S0 61.1 -> 57.1 and A_F0 95.2 -> 102.2 degC (found by review)."""
+    c = real_curves[0]
+    lines = Path(c.path).read_text().splitlines()
+    shifted = []
+    for line in lines:
+        f = line.split()
+        try:
+            f[1] = repr(float(f[1]) + 0.003)
+        except (IndexError, ValueError):
+            pass
+        shifted.append(" ".join(f))
+    (tmp_path / "shifted.txt").write_text("\n".join(shifted) + "\n")
+    moved = load_strain_curve(tmp_path / "shifted.txt")
+    assert np.min(moved.strain) == 0.0 and np.min(c.strain) == 0.0
+    np.testing.assert_allclose(moved.strain, c.strain, atol=1e-12)
+
+
+def test_a_curve_fitted_and_validated_or_fitted_twice_is_refused(real_curves):
+    """``--validate`` of a fitted file printed its fitted RMS as "validated"; a file given twice
+    (another spelling) doubled its weight (found by review). Both exit 2, nothing written."""
+    path = Path(real_curves[3].path)
+    other = str(path.parent / ".." / path.parent.name / path.name)
+    for args in ([str(path), "--validate", str(path)], [str(path), other]):
+        r = CliRunner().invoke(app, ["kinetics", *[c.path for c in real_curves[:3]], *args, "--no-progress"])
+        assert r.exit_code == 2 and "given twice" in r.stderr, r.stderr

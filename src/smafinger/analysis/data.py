@@ -114,7 +114,7 @@ class StrainCurve:
 
     path: str
     T_C: np.ndarray
-    strain: np.ndarray
+    strain: np.ndarray  #: from the curve's minimum (the austenite state): the file's values shifted
     stress_Pa: np.ndarray
     split: int  # row index of the maximum temperature (last row of the heating half)
 
@@ -180,7 +180,10 @@ def load_strain_curve(path: str | Path) -> StrainCurve:
             f"leaves too few points for the {half} half (rows must heat first, then cool; at "
             f"least {MIN_ROWS_HALF} rows each)")
     _check_transformation(path, T, e, split)
-    return StrainCurve(str(path), T, e, s * 1e6, split)
+    # the strain measured from the curve's austenite state, its minimum (kinetics_fit: "Offset");
+    # the fit has no free offset, so a file measured from another reference (the unloaded length)
+    # would move every fitted temperature
+    return StrainCurve(str(path), T, e - float(np.min(e)), s * 1e6, split)
 
 
 def _check_transformation(path, T: np.ndarray, e: np.ndarray, split: int) -> None:

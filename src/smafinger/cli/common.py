@@ -40,6 +40,19 @@ def refuse(ctx: typer.Context, names: tuple[str, ...], because: str) -> None:
         raise UsageError(f"{' and '.join(clash)}: not used {because}")
 
 
+def repeated_file(files) -> str | None:
+    """Why one of ``files`` is given twice (one file under two spellings, ``./a.csv``, its absolute
+    path or a link, is one file), or None: a file fitted twice weighs double, and one fitted and
+    validated is not held out."""
+    seen: dict[Path, str] = {}
+    for f in map(str, files):
+        key = Path(f).resolve()
+        if key in seen:
+            return f"{f}: given twice (as {seen[key]!r} and {f!r}); give each file once, with one role"
+        seen[key] = f
+    return None
+
+
 def load_params(text: str, overrides: list[str] | None, what: str = "--params"):
     """The parameter set named by an option (a registry name or a .toml file) with ``--set``
     overrides; bad input raises :class:`UsageError` naming the option."""

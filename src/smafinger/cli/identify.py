@@ -19,8 +19,8 @@ from typing import List, Literal, Optional
 
 import typer
 
-from .common import help_when_bare, load_params, progress_display, progress_option
-from .errors import NOTHING_WRITTEN, command, reading_input
+from .common import help_when_bare, load_params, progress_display, progress_option, repeated_file
+from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 from .identify_actuator import actuator
 
 app = typer.Typer(add_completion=False, invoke_without_command=True, pretty_exceptions_enable=False,
@@ -100,6 +100,8 @@ def kinetics(
     from ..analysis.identify import identify_kinetics
 
     targets = _targets(out, report, plot)
+    if (twice := repeated_file([*files, *(validate or [])])) is not None:
+        raise UsageError(twice)
     base_set, base_spec = _base(params, set_)
     with progress_display(progress) as display:
         ident = identify_kinetics(files, validate or [], base_set, base_spec, fit_moduli, stress, loo, display)

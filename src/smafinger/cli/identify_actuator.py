@@ -23,6 +23,7 @@ from typing import Callable, List, Optional
 import typer
 
 from .choices import FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
+from .common import repeated_file
 
 CMD = "smafinger identify actuator"
 #: warn when the fitted runs' RMS exceeds the baseline noise by this factor
@@ -117,12 +118,8 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     _check_path("--report", report, (".json",))
     if plot is not None and (plot.exists() and not plot.is_dir() or not plot.parent.exists()):
         raise Usage(f"--plot {plot}: must be a directory (its parent must exist)")
-    seen: dict[Path, str] = {}
-    for f in (_split_run(a)[0] for a in fit + validate + replay):
-        key = Path(f).resolve()  # one file under two spellings (./a.csv, its absolute path, a link) is one run
-        if key in seen:
-            raise Usage(f"{f}: given twice (as {seen[key]!r} and {f!r}); give each run once, with one role")
-        seen[key] = f
+    if (twice := repeated_file(_split_run(a)[0] for a in fit + validate + replay)) is not None:
+        raise Usage(twice)
     p = resolve(params).with_overrides(overrides)
     parse_map_options(maps)  # refuse a bad --map before reading any file
     controller = _controller(gains, duty_max) if replay else None
