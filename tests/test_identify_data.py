@@ -213,7 +213,11 @@ def test_voltage_programs_from_columns_and_heat_s(tmp_path):
     rows = ["time,angle,voltage"] + [f"{0.5 * i},{-40},{8 if i < 6 else 0}" for i in range(20)]
     c = load_angle_curve(write(tmp_path / "c.csv", rows))
     assert cooling_program(c, 5.0, None).steps == ((0.0, 8.0, 0.0), (3.0, 0.0, 0.0))
-    assert cooling_program(c, 5.0, 2.5).steps == ((0.0, 5.0, 0.0), (2.5, 0.0, 0.0))  # --heat-s wins
+    assert cooling_program(c, 8.0, 3.0).steps == ((0.0, 8.0, 0.0), (3.0, 0.0, 0.0))  # --heat-s matching the file
+    with pytest.raises(ValueError, match="contradicts the voltage column"):  # it used to win, at 8 V by default
+        cooling_program(c, 5.0, 2.5)
+    with pytest.raises(DataError, match="switches off at t = 3 s"):  # the end of a heating curve is a cooling
+        heating_program(c, 5.0)
     h = load_angle_curve(write(tmp_path / "h.csv", angle_rows(voltage=False)))
     assert heating_program(h, 6.0).steps == ((0.0, 6.0, 0.0),)
     with pytest.raises(ValueError, match="heat_s"):

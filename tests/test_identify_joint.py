@@ -110,3 +110,35 @@ def test_identify_is_mounted_on_the_main_cli(tmp_path):
         pytest.skip("main CLI not present")
     rc = main(["identify", "joint", "--heating", str(tmp_path / "nope.csv"), "--cooling", str(tmp_path / "x.csv")])
     assert rc == 2
+
+
+def test_coefficients_the_curves_do_not_see_are_reported_unknown_not_exact(tmp_path):
+    """A 5 V cooling curve along which the joint never moves: the cooling coefficients were
+    reported '+- 0 (0%)' with no warning (pinv gives an unseen direction a variance of 0; found
+    by review). Now their errors are infinite (null in the report) and the fit says so."""
+    heat = write_csv(tmp_path / "heat.csv", synthesize(TRUTH, "0:5:0", 22.0, SAMPLE_S, NOISE_DEG, seed=4))
+    cool = write_csv(tmp_path / "cool.csv", synthesize(TRUTH, "0:5:0,6:0:0", 16.0, SAMPLE_S, NOISE_DEG, seed=3))
+    rep = tmp_path / "fit.json"
+    r = CliRunner().invoke(app, ["joint", "--heating", str(heat), "--cooling", str(cool), "--report", str(rep),
+                                 "--no-progress"])
+    assert r.exit_code == 0, r.stderr
+    cooling = json.loads(rep.read_text())["cooling"]
+    assert all(v is None for v in cooling["rel_stderr"].values())
+    assert "+- inf" in r.stdout and "cooling: weakly identified" in r.stderr
+    heating = json.loads(rep.read_text())["heating"]
+    assert all(0 < v < 0.1 for v in heating["rel_stderr"].values())
+
+
+def test_a_coefficient_stopped_at_its_search_bound_is_warned_of():
+    """h0_cooling = 9999.99, the end of its range, was shown '+- 0.277 (0.0028%)' with no word."""
+    from types import SimpleNamespace
+
+    from smafinger.analysis.joint_phase import _bound_warnings
+
+    obj = SimpleNamespace(fields=("h0_cooling_W_m2K", "C_DF_cooling_Nms"), bounds=[(-4.6, 5.5), (-6.9, 4.6)])
+    w = _bound_warnings("cooling", obj, np.array([5.5, 0.0]), {"h0_cooling_W_m2K": 9999.99, "C_DF_cooling_Nms": 0.09})
+    assert w == ["cooling: h0_cooling_W_m2K = 9999.99 is at the upper bound of its search range: the curves push it "
+                 "further, so the value is the bound's and its standard error does not apply"]
+    assert _bound_warnings("cooling", obj, np.array([0.0, -6.9]), {"h0_cooling_W_m2K": 41.0,
+                                                                    "C_DF_cooling_Nms": 1e-4})[0].startswith(
+        "cooling: C_DF_cooling_Nms = 0.0001 is at the lower bound")

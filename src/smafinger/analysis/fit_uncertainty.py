@@ -106,7 +106,7 @@ def covariance(J: np.ndarray, residuals: np.ndarray, slices: Sequence[slice]) ->
     n, p = J.shape
     dof = max(n - p, 1)
     A = J.T @ J
-    unidentified = _null_directions(A)
+    unidentified = null_directions(A)
     rank_deficient = bool(unidentified.any())
     A_inv = np.linalg.pinv(A) if rank_deficient else np.linalg.inv(A)
     scale = n / dof  # the residuals' mean square underestimates the noise variance by dof / n
@@ -123,7 +123,7 @@ def covariance(J: np.ndarray, residuals: np.ndarray, slices: Sequence[slice]) ->
     return Covariance(ar1, white, rho, sigma, dof, rank_deficient)
 
 
-def _null_directions(A: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
+def null_directions(A: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
     """Which quantities take part in a direction J^T J does not see (bool per column)."""
     scale = np.sqrt(np.maximum(np.diag(A), 0.0))
     zero = scale == 0.0

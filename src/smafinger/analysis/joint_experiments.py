@@ -40,9 +40,16 @@ def program_from_voltage(curve: AngleCurve) -> VoltageProgram:
 
 
 def heating_program(curve: AngleCurve, voltage_V: float) -> VoltageProgram:
-    """The heating experiment's program: the voltage column, else ``voltage_V`` from t = 0."""
+    """The heating experiment's program: the voltage column, else ``voltage_V`` from t = 0.
+    Raises DataError if the column switches the voltage off: the curve's end is then a cooling,
+    which the heating phase's coefficients do not describe."""
     if curve.voltage_V is not None:
-        return program_from_voltage(curve)
+        prog = program_from_voltage(curve)
+        off = next((t for t, v, _ in prog.steps if v == 0.0 and t > 0.0), None)
+        if off is not None:
+            raise DataError(f"{curve.path}: the voltage column switches off at t = {off:g} s, so the curve "
+                            "ends in a cooling: give it as a cooling curve (--cooling), or cut it there")
+        return prog
     return VoltageProgram(((0.0, float(voltage_V), 0.0),))
 
 
@@ -55,7 +62,12 @@ def cooling_program(curve: AngleCurve, voltage_V: float, heat_s: float | None) -
         if heat_s >= curve.t_s[-1]:
             raise ValueError(f"heat_s = {heat_s:g} s is not before the end of the cooling curve "
                              f"{curve.path} ({curve.t_s[-1]:g} s)")
-        return VoltageProgram(((0.0, float(voltage_V), 0.0), (round(float(heat_s), 9), 0.0, 0.0)))
+        given = VoltageProgram(((0.0, float(voltage_V), 0.0), (round(float(heat_s), 9), 0.0, 0.0)))
+        if curve.voltage_V is not None and program_from_voltage(curve).steps != given.steps:
+            raise ValueError(f"heat_s = {heat_s:g} s at {voltage_V:g} V ({program_text(given)}) contradicts the "
+                             f"voltage column of {curve.path} ({program_text(program_from_voltage(curve))}): give "
+                             "--heat-s only for cooling curves without a voltage column, or matching it")
+        return given
     if curve.voltage_V is not None:
         prog = program_from_voltage(curve)
         if prog.steps[-1][1] != 0.0:

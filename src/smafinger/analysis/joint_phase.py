@@ -19,6 +19,7 @@ from scipy.optimize import least_squares
 from ..parameters import ParameterSet
 from ..profiles import VoltageProgram
 from .data import AngleCurve
+from .fit_uncertainty import null_directions
 from .joint_experiments import program_text
 from .joint_objective import PhaseObjective
 
@@ -89,8 +90,25 @@ def fit_phase(phase: str, experiments: Sequence[tuple[AngleCurve, VoltageProgram
         rms_deg=math.sqrt(float(r @ r) / r.size), rms_start_deg=rms_start,
         curves=_per_curve(experiments, r), nfev=obj.nfev, wall_s=time.perf_counter() - t0,
         scan_factor=best_k, success=success, message=f"{message} ({runs} least-squares run(s))",
-        warnings=_identifiability_warnings(phase, fields, corr, sd),
+        warnings=_identifiability_warnings(phase, fields, corr, sd) + _bound_warnings(phase, obj, z, values),
     )
+
+
+#: a fitted log-value this close to an end of its search range is at the bound
+AT_BOUND = 1e-6
+
+
+def _bound_warnings(phase: str, obj: PhaseObjective, z: np.ndarray, values: dict) -> list[str]:
+    """A field the fit stopped at an end of its search range: the data push it further, so its
+    value is the bound's and its standard error does not describe it."""
+    out = []
+    for i, f in enumerate(obj.fields):
+        lo, hi = obj.bounds[i]
+        end = "upper" if z[i] >= hi - AT_BOUND else "lower" if z[i] <= lo + AT_BOUND else None
+        if end is not None:
+            out.append(f"{phase}: {f} = {values[f]:.6g} is at the {end} bound of its search range: the curves "
+                       "push it further, so the value is the bound's and its standard error does not apply")
+    return out
 
 
 def _phase_start(phase: str, experiments: Sequence[tuple[AngleCurve, VoltageProgram]], base: ParameterSet,
@@ -278,7 +296,11 @@ def _log_uncertainty(obj: PhaseObjective, values: dict[str, float]) -> tuple[np.
         J[:, i] = (obj.residuals_at(up) - obj.residuals_at(dn)) / (2 * DIFF_STEP)
     dof = max(r.size - len(obj.fields), 1)
     s2 = float(r @ r) / dof
-    cov = s2 * np.linalg.pinv(J.T @ J)  # of log(value): relative
+    A = J.T @ J
+    cov = s2 * np.linalg.pinv(A)  # of log(value): relative
+    # a field the curves do not see (its column of J zero, or in a direction J^T J does not see):
+    # infinitely uncertain, not exact (pinv gives such a field a variance of 0)
+    cov[null_directions(A), :] = np.inf
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(sd, sd)
