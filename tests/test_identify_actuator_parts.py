@@ -2,6 +2,7 @@
 controller, synthetic files in CSV and Simulink layouts."""
 
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -232,3 +233,25 @@ def test_bench_run_refusals(tmp_path):
         load_closed_loop(tmp_path / "early.csv", None, LINEAR, RigController())
     with pytest.raises(BenchRunError, match="role 'train'"):
         load_open_loop(tmp_path / "joint.csv", None, "train", JOINT)
+
+
+def test_a_run_whose_drive_is_on_from_its_first_sample_has_no_baseline_but_that_sample(tmp_path):
+    """The baseline (offset and noise) lasted while the input kept its first value, drive on or
+    not: the shipped step run cut where its drive comes on counted 551 samples of heating as rest,
+    giving a 5.50 mm offset (truth 1.2), 7.5 mm of "noise" and a held-out RMS/noise of 0.58
+    (found by review). Now only its first sample, and no noise estimate."""
+    import pandas as pd
+
+    import smafinger
+    from smafinger.analysis.bench_runs import load_open_loop
+    from smafinger.parameters import resolve
+
+    data = pathlib.Path(smafinger.__file__).parent / "data"
+    df = pd.read_csv(data / "bench_step.csv", dtype=str, keep_default_na=False)
+    df[df.t_s.astype(float) >= 0.5].to_csv(tmp_path / "late.csv", index=False)
+    p = resolve(data / "bench_truth.toml")
+    late = load_open_loop(tmp_path / "late.csv", None, "validate", p)
+    assert late.baseline.sum() == 1 and late.baseline_noise() is None
+    assert late.baseline_offset(p) == pytest.approx(1.2e-3, abs=2e-4)
+    whole = load_open_loop(data / "bench_step.csv", None, "validate", p)
+    assert whole.baseline.sum() > 10 and whole.baseline_noise() < 1e-4

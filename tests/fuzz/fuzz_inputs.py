@@ -288,10 +288,11 @@ def strain_file(draw) -> str:
 
 
 @st.composite
-def angle_file(draw) -> str:
+def angle_file(draw, heating: bool = False) -> str:
+    """A joint angle curve; a heating curve's voltage mostly stays on (switching it off is refused)."""
     n = draw(st.integers(0, 25))
     voltage = draw(st.booleans())
-    off = draw(st.integers(0, max(0, n - 1)))
+    off = n if heating and chance(draw, 0.8) else draw(st.integers(0, max(0, n - 1)))
     rows = ["time_s,angle_deg" + (",voltage_V" if voltage else "")]
     for i in range(n):
         t = 0.1 * i
@@ -331,9 +332,10 @@ def identify_cases(draw) -> Case:
         if chance(draw, 0.2):
             argv += ["--validate", draw(st.sampled_from(["k0.txt", "missing.txt", "d"]))]
         return Case(argv + extra, {**inputs, "d": None}, keep)
-    inputs = {"h.csv": draw(angle_file()), "c.csv": draw(angle_file()), "d": None}
+    inputs = {"h.csv": draw(angle_file(heating=True)), "c.csv": draw(angle_file()), "d": None}
     argv = ["identify", "joint", "--heating", "h.csv", "--cooling", "c.csv", "--no-progress"]
-    if draw(st.booleans()):
+    # --heat-s is for a cooling curve without a voltage column (one that contradicts it is refused)
+    if chance(draw, 0.2 if "voltage_V" in inputs["c.csv"] else 0.5):
         argv += ["--heat-s", draw(st.sampled_from(["0.5", "1", "99", "-1", "nan", "x"]))]
     if chance(draw, 0.3):
         argv += ["--cooling-voltage", draw(st.sampled_from(["8", "0", "101", "nan"]))]

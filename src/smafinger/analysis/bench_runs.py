@@ -210,6 +210,10 @@ def _grid(rec: Recording, what: str, dt_s: float) -> tuple[float, float, OutputS
     return interval, t_end, output_on_grid(rec, grid)
 
 
+#: an input that starts at most this fraction of its largest value starts idle (at rest)
+IDLE_FRACTION = 0.05
+
+
 def _rest_mask(t_out: np.ndarray, t_rest: float) -> np.ndarray:
     mask = t_out <= t_rest + 1e-9
     mask[0] = True
@@ -249,8 +253,14 @@ def load_open_loop(path, mapping, role: str, p: ParameterSet, wire: str | None =
     _check_role(role)
     rec = _read(path, mapping, p).with_time_origin()
     interval, t_end, samples = _grid(rec, "input", dt_s)
-    on = np.flatnonzero(rec.input.values != rec.input.values[0])  # the input leaves its rest value
-    t_rest = float(rec.input.t_s[on[0]]) if on.size else math.inf
+    # the baseline (at rest: the offset and the noise are measured there) lasts until the input
+    # first changes, if it starts idle (off, or at most IDLE_FRACTION of its largest value: a
+    # sensing current); a run whose drive is on from its first sample has none but that sample
+    # (its whole heating counted as rest gave a 5.5 mm offset and 7.5 mm of "noise")
+    u = rec.input.values
+    on = np.flatnonzero(u != u[0])
+    idle = abs(float(u[0])) <= IDLE_FRACTION * float(np.max(np.abs(u)))
+    t_rest = (float(rec.input.t_s[on[0]]) if on.size else math.inf) if idle else -math.inf
     return BenchRun(str(path), role, "open-loop", rec, samples, interval, t_end,
                     _rest_mask(rec.output.t_s, t_rest), program=drive_program(rec, p, wire))
 
