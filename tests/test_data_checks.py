@@ -86,10 +86,21 @@ def test_fitted_parameter_files_start_from_the_named_set(tmp_path):
                                                                        A_S0_C=61.5)
 
 
-def test_data_whose_fit_is_no_valid_set_are_refused_with_the_field(tmp_path, capsys):
-    """A heating half that only starts to transform at the top of the data extrapolates A_F0
-    beyond its range: bad data, exit 2 naming the field (it was exit 1 'failed', found by the
-    long fuzz)."""
+def test_data_whose_fit_is_no_valid_set_are_refused_with_the_field(tmp_path, capsys, monkeypatch):
+    """A fit that extrapolates A_F0 beyond its range is bad data: exit 2 naming the field (it was
+    exit 1 'failed', found by the long fuzz). The long fuzz's curve did so only because its strain
+    was not shifted to start at 0 (fixed); the fit's result is made to extrapolate here."""
+    import dataclasses
+
+    from smafinger.analysis import kinetics_fit as kf
+
+    real = kf.fit_kinetics
+
+    def extrapolating(*args, **kwargs):
+        fit = real(*args, **kwargs)
+        return dataclasses.replace(fit, params=dataclasses.replace(fit.params, A_F0_C=312.0))
+
+    monkeypatch.setattr(kf, "fit_kinetics", extrapolating)
     T = np.concatenate([np.linspace(30, 299, 30), np.linspace(299, 30, 31)[1:]])
     e = np.where(np.arange(60) < 30, 0.04 - 0.02 * np.clip((T - 270) / 29, 0, 1),
                  0.02 + 0.02 * np.clip((120 - T) / 40, 0, 1))
