@@ -19,7 +19,7 @@ def print_run(result) -> None:
     fmt = ".2f" if u == "deg" else ".5f"
     for s in m["segments"]:
         reached = "never" if s["reached_s"] is None else f"{s['reached_s']:.3f}"
-        over = s[f"overshoot_{u}"]  # None: the segment has no output sample (it began at the end)
+        over = s[f"overshoot_{u}"]  # None: no output sample in the segment (a target never pursued)
         table.add_row(str(s["index"]), f"{s['start_s']:.3f}", format(s[f"target_{u}"], fmt), reached,
                       "-" if over is None else format(over, fmt))
     console.print(table)

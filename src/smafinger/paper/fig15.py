@@ -152,10 +152,12 @@ def _last_moves(v: dict) -> str:
     """On a schedule a cycle is its earlier moves' slots plus its last move: what the time bands test."""
     parts = []
     for k in PAPER_S:
-        moves = v[f"{k}_reached_s"] or []
+        moves = v[f"{k}_reached_s"]
+        if not moves:
+            parts.append(f"{STRATEGY_NAMES[k]} not run")
+            continue
         slots = (len(moves) - 1) * MOVE_S
-        parts.append(f"{STRATEGY_NAMES[k]} {secs(moves[-1] if moves else None)} (the paper's time implies "
-                     f"{PAPER_S[k] - slots:g} s)")
+        parts.append(f"{STRATEGY_NAMES[k]} {secs(moves[-1])} (the paper's time implies {PAPER_S[k] - slots:g} s)")
     return ("a scheduled cycle is its earlier moves' slots plus its last move, so the time bands test the last "
             "move: " + ", ".join(parts))
 
