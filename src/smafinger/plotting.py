@@ -36,15 +36,15 @@ def plot_result(result, path: str | Path | None = None, title: str | None = None
     p = result.spec.params
     q, q_ref, v, k, sym, q_label, v_label = _AXES[p.mechanism]
     t = result.t
+    open_loop = result.spec.strategy == "open-loop"
     fig, ax = plt.subplots(5, 1, figsize=(7.5, 10.5), sharex=True, constrained_layout=True)
     ax[0].plot(t, k * result.signal(q), color="k", label=sym)
-    if result.spec.strategy != "open-loop":  # open loop pursues no target
+    if not open_loop:  # open loop pursues no target
         ax[0].plot(t, k * result.signal(q_ref), color="tab:red", ls="--", lw=1.0, label="target")
     ax[0].set_ylabel(q_label)
     ax[0].legend(loc="best", fontsize=8)
     ax[1].plot(t, k * result.signal(v), color="k")
     ax[1].set_ylabel(v_label)
-    open_loop = result.spec.strategy == "open-loop"
     for i, w in enumerate(p.wire_names):
         c = _COLORS[i % len(_COLORS)]
         ax[2].plot(t, result.signal(f"T_{w}_C"), color=c, label=w)

@@ -7,7 +7,6 @@ import os
 import threading
 import time
 from dataclasses import dataclass
-from pathlib import PurePath
 
 import numpy as np
 
@@ -16,11 +15,12 @@ from ..control.strategies import STRATEGIES, enable_mask
 from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
 from ..progress import Display
-from ..profiles import DRIVE_KINDS, ProfileError, TargetProfile, VoltageProgram
+from ..profiles import ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
 from . import integrators, interpreted, numerics, pwm as pwm_models
 from .compiled import INTERPRETED, kernels
 from .kernel import Program, RunSettings, memory_stacks
+from .run_inputs import check_output_grid, check_tolerance_unit, check_types
 from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG,  # noqa: F401
@@ -69,7 +69,7 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     argument and the value.
     """
     given = {k: v for k, v in (("dt_s", dt_s), ("method", method), ("pwm", pwm)) if v is not None}
-    _check_types(params=params, strategy=strategy, profile=profile, voltage=voltage, t_end_s=t_end_s,
+    check_types(params=params, strategy=strategy, profile=profile, voltage=voltage, t_end_s=t_end_s,
                  output_interval_s=output_interval_s, tol_deg=tol_deg, hold_s=hold_s,
                  independent_wait=independent_wait, tol_m=tol_m, drive=drive, **given)
     p = resolve(params)
@@ -93,7 +93,7 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     for name, v in (("tol_deg", tol_deg), ("tol_m", tol_m), ("hold_s", hold_s)):
         if not math.isfinite(v) or v < 0:
             raise ValueError(f"{name} = {v!r} must be a finite number >= 0")
-    _check_tolerance_unit(p, tol_deg, tol_m)
+    check_tolerance_unit(p, tol_deg, tol_m)
     if controller is not None:
         controller = controller_from(controller).prepared(p)
         if strategy == "open-loop":
@@ -109,40 +109,10 @@ def make_spec(params="paper2010", strategy="cooperative", profile=None, voltage=
     return spec
 
 
-#: make_spec arguments -> (accepted types, what to give)
-_NUMBER = "a number"
-_ARG_TYPES = {
-    "params": ((str, PurePath, ParameterSet), "a set's name, a .toml path or a ParameterSet"),
-    "strategy": ((str,), f"one of {', '.join(STRATEGIES)}"),
-    "profile": ((str, TargetProfile, type(None)), 'a profile text such as "0:-25,reach:-55" or a TargetProfile'),
-    "voltage": ((str, VoltageProgram, type(None)), 'a program text such as "0:8:0,6:0:0" or a VoltageProgram'),
-    "method": ((str,), f"one of {', '.join(integrators.INTEGRATORS)}"),
-    "drive": ((str,), f"one of {', '.join(DRIVE_KINDS)}"),
-    "pwm": ((str,), f"one of {', '.join(pwm_models.PWM_MODELS)}"),
-    "independent_wait": ((bool, np.bool_), "True or False"),
-}
-
-
 def _numerics(p, controller, t_end_s, method, dt_s, pwm, program) -> tuple:
     """(dt_s, method, pwm): those given, else the run's default (:mod:`.numerics`)."""
     n = numerics.choose(p, controller, t_end_s, method, dt_s, pwm, program)
     return n.dt_s, n.method, n.pwm
-
-
-def _check_types(**args) -> None:
-    """``TypeError`` naming the first argument of the wrong type (numbers: not bool, not text)."""
-    for name, value in args.items():
-        if name in _ARG_TYPES:
-            types, want = _ARG_TYPES[name]
-            ok = isinstance(value, types)
-        else:
-            want = _NUMBER
-            ok = (isinstance(value, (int, float, np.integer, np.floating))
-                  and not isinstance(value, (bool, np.bool_)))
-        if not ok:
-            raise TypeError(f"{name} = {value!r} is not {want}")
-    if args["drive"] not in DRIVE_KINDS:
-        raise ValueError(f"drive = {args['drive']!r} is not one of {', '.join(DRIVE_KINDS)}")
 
 
 def memory_limit_bytes() -> int:
@@ -214,26 +184,6 @@ def _program(spec: RunSpec, model) -> Program:
     return Program(ticks_array(f"{prog.kind} start", cols[0]), level, duty)
 
 
-def _check_tolerance_unit(p: ParameterSet, tol_deg: float, tol_m: float) -> None:
-    """A tolerance in the other mechanism's unit would be ignored (``tol_deg`` on a slider)."""
-    unused, value, default = (("tol_m", tol_m, DEFAULT_TOL_M) if p.coordinate.unit == "deg"
-                              else ("tol_deg", tol_deg, DEFAULT_TOL_DEG))
-    if value != default:
-        used = "tol_deg" if unused == "tol_m" else "tol_m"
-        raise ValueError(f"{unused} = {value!r} does not apply to {p.name}, whose targets are in {p.coordinate.unit}: "
-                         f"give {used}")
-
-
-def _check_output_grid(spec: RunSpec, run) -> None:
-    """The output grid must end at t_end: the totals and the last segment's metrics are read at the
-    last sample (with 3 s over 10 s the run's energy was the energy at 9 s)."""
-    if run.t_end_ticks % run.out_ticks:
-        below = run.t_end_ticks // run.out_ticks * run.out_ticks * TICK_S
-        raise ValueError(f"t_end_s = {spec.t_end_s!r} is not a whole multiple of output_interval_s = "
-                         f"{spec.output_interval_s!r}: the last sample would be at {below:.9g} s, not at the end "
-                         f"(t_end_s = {below:.9g} or {below + run.out_ticks * TICK_S:.9g} would do)")
-
-
 def kernel_args(spec: RunSpec, record: str = "all") -> dict:
     """The records and arrays the kernel takes (validated); ``record``: see :func:`run_spec`."""
     t_end = to_ticks("t_end_s", spec.t_end_s)
@@ -253,7 +203,7 @@ def kernel_args(spec: RunSpec, record: str = "all") -> dict:
         tol=p.to_si(spec.tolerance), hold_ticks=to_ticks("hold_s", spec.hold_s, True),
         pwm=pwm_models.PwmModel.SAMPLED if integ.pwm_sampled else pwm_models.get(spec.pwm),
         every_signal=every_signal(record))
-    _check_output_grid(spec, run)
+    check_output_grid(spec, run)
     _check_output_size(spec, run)
     model = build_model(p)
     if spec.controller is not None:
