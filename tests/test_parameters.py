@@ -8,6 +8,8 @@ from hypothesis import strategies as st
 
 from smafinger.parameters import ParameterError, get, load_toml, resolve
 from smafinger.parameters.base import ParameterSet
+from smafinger.parameters.options import SpringInit
+from smafinger.model.build import initial_spring_elongations
 
 
 def test_named_sets_cite_their_source():
@@ -40,10 +42,22 @@ def test_out_of_range_value_refused_with_field_value_and_range(v):
 def test_cross_checks():
     with pytest.raises(ParameterError, match="A_S0_C"):
         get("paper2010").replace(A_S0_C=120.0)
-    with pytest.raises(ParameterError, match="spring_length_upper_m"):
-        get("paper2010").replace(spring_length_upper_m=5e-3)
+    with pytest.raises(ParameterError, match="must exceed spring_free_length_m"):
+        get("paper2010").replace(spring_length_upper_m=5e-3, spring_init="given")
     with pytest.raises(ParameterError, match="stress_law"):
         get("paper2010").replace(stress_law="magic")
+
+
+def test_an_upper_spring_length_the_equilibrium_start_ignores_is_refused():
+    p = get("paper2010")
+    assert p.spring_init == SpringInit.EQUILIBRIUM
+    with pytest.raises(ParameterError, match="spring_length_upper_m = 0.018 has no effect"):
+        p.replace(spring_length_upper_m=0.018)
+    given = p.replace(spring_length_upper_m=0.018, spring_init="given")
+    assert initial_spring_elongations(given)[0] == pytest.approx(0.018 - p.spring_free_length_m)
+    assert p.replace(spring_length_upper_m=p.spring_length_upper_m) == p  # unchanged: accepted
+    with pytest.raises(ParameterError, match="has no effect"):  # the same through --set
+        given.with_overrides(["spring_init=equilibrium", "spring_length_upper_m=0.0175"])
 
 
 def test_frozen():

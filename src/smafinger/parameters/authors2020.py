@@ -17,14 +17,16 @@ SOURCE = "Gilardi, FingerControl Simulink model (github.com/gabrielegilardi/Fing
 
 
 def parameters() -> JointParameters:
-    return _paper().replace(
+    # the model file's upper spring length, kept as its record: the equilibrium start below
+    # solves the upper spring (a new length is refused under it, JointParameters.replace)
+    recorded = _paper().replace(spring_init="given", spring_length_upper_m=17.44e-3)
+    return recorded.replace(
         name="authors2020",
         source=SOURCE,
         resistance_ohm_per_m=8.66,
         M_SF_Nm=0.011,
         T_amb_C=60.0,
         T_init_C=60.0,
-        spring_length_upper_m=17.44e-3,
         spring_length_lower_m=15.48e-3,
         spring_init="equilibrium",
         K_P_per_rad=8000.0,

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import ClassVar, NamedTuple
 
 from .base import ParameterError, ParameterSet, _num
+from .options import SpringInit
 
 
 class Coordinate(NamedTuple):
@@ -78,6 +79,18 @@ class JointParameters(ParameterSet):
     def initial_target(self) -> float:
         """The coordinate at the start, in the user unit (deg)."""
         return self.theta0_deg
+
+    def replace(self, **changes):
+        """A copy with some parameters or options changed (validated); a new
+        ``spring_length_upper_m`` is refused where ``spring_init = equilibrium`` ignores it."""
+        new = super().replace(**changes)
+        if ("spring_length_upper_m" in changes and new.spring_init == SpringInit.EQUILIBRIUM
+                and new.spring_length_upper_m != self.spring_length_upper_m):
+            raise ParameterError(
+                f"spring_length_upper_m = {new.spring_length_upper_m} has no effect with spring_init = "
+                f"equilibrium (the upper spring is solved from the moment balance at theta0_deg); "
+                f"set spring_init=given with it")
+        return new
 
     def _cross_checks(self) -> None:
         super()._cross_checks()
