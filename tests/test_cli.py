@@ -38,7 +38,8 @@ def test_params_file_and_set(tmp_path):
     assert main(["params", "authors2020", "--set", "M_SF_Nm=0.02", "--out", str(f)]) == 0
     js = tmp_path / "s.json"
     assert main(["simulate", "--params", str(f), "--profile", "0:-25:upper", "--t-end", "2", "--summary", str(js)]) == 0
-    assert json.loads(js.read_text())["params"] == "authors2020"
+    summary = json.loads(js.read_text())
+    assert summary["params"] == "authors2020" and summary["params_changed"] == ["M_SF_Nm"]
 
 
 @pytest.mark.parametrize("args,needle", [

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from smafinger.parameters import ParameterError, get, load_toml, resolve
+from smafinger.parameters import ParameterError, changed_from_named, get, load_toml, resolve
 from smafinger.parameters.base import ParameterSet
 from smafinger.parameters.options import SpringInit
 from smafinger.model.build import initial_spring_elongations
@@ -58,6 +58,15 @@ def test_an_upper_spring_length_the_equilibrium_start_ignores_is_refused():
     assert p.replace(spring_length_upper_m=p.spring_length_upper_m) == p  # unchanged: accepted
     with pytest.raises(ParameterError, match="has no effect"):  # the same through --set
         given.with_overrides(["spring_init=equilibrium", "spring_length_upper_m=0.0175"])
+
+
+def test_a_set_changed_under_its_name_lists_what_changed():
+    p = get("paper2010")
+    assert changed_from_named(p) == ()
+    q = p.with_overrides(["K_P_per_rad=4000", "stress_law=algebraic", "h0_heating_W_m2K=20"])  # h0: its own value
+    assert q.name == "paper2010" and changed_from_named(q) == ("K_P_per_rad", "stress_law")
+    assert changed_from_named(q.replace(name="mine")) == ()  # no set of that name to differ from
+    assert changed_from_named(get("linear-bias-spring").replace(V_H_V=3.0)) == ("V_H_V",)
 
 
 def test_frozen():

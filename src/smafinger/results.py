@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from .engine.signals import MC, WC, columns, structured
+from .parameters import changed_from_named
 from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older imports)
 from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
@@ -140,6 +141,7 @@ class SimulationResult:
         """Metrics plus run statistics, JSON-ready."""
         m = dict(self.metrics)
         m["params"] = self.spec.params.name
+        m["params_changed"] = list(changed_from_named(self.spec.params))  # from the set of that name
         m["mechanism"] = self.spec.params.mechanism
         m["strategy"] = self.spec.strategy
         m["method"] = self.spec.method

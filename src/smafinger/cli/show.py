@@ -13,7 +13,10 @@ def print_run(result) -> None:
     m = result.summary()
     u = result.spec.params.coordinate.unit
     console = Console()
-    table = Table(title=f"{m['params']} / {m['strategy']}  ({m['steps']} steps, {1e3 * m['wall_s']:.1f} ms)")
+    changed = m["params_changed"]
+    changed = (f" ({', '.join(changed) if len(changed) <= 3 else f'{len(changed)} fields'} changed)"
+               if changed else "")
+    table = Table(title=f"{m['params']}{changed} / {m['strategy']}  ({m['steps']} steps, {1e3 * m['wall_s']:.1f} ms)")
     for col in ("segment", "start [s]", f"target [{u}]", "reached [s]", f"overshoot [{u}]"):
         table.add_column(col, justify="right")
     fmt = ".2f" if u == "deg" else ".5f"
