@@ -301,3 +301,18 @@ def test_fig13_asks_that_the_antagonist_pulls():
         assert [c.test(v) for c in claim.checks] == [True, False]
         assert [c.test({**v, "antagonist_xi_min": 0.9}) for c in claim.checks] == [True, True]
         assert "damping" in claim.known_gap
+
+
+def test_a_move_is_over_when_reached_and_cooled_not_when_cooled_alone():
+    """The per-move table compared 'the wires it began partly austenite back to martensite' with
+    the paper's move time: 0.0 s for every outward move, which begins all martensite (noticed in
+    review). A move now counts as over by that definition when it is reached and cooled."""
+    from smafinger.engine.run import simulate
+    from smafinger.paper.derived import segment_detail
+    from smafinger.paper.issue10 import MOVE_ENDS
+
+    r = simulate("paper2010", profile="0:-30,6:-40", t_end_s=12.0)
+    out, back = segment_detail(r, 0), segment_detail(r, 1)
+    assert out["cooled_s"] == 0.0 and out["reached_s"] > 1.0 and out["reached_cooled_s"] == out["reached_s"]
+    assert back["cooled_s"] > 0.0 and back["reached_cooled_s"] == max(back["reached_s"], back["cooled_s"])
+    assert "cooled_s" not in dict(MOVE_ENDS) and "reached_cooled_s" in dict(MOVE_ENDS)

@@ -34,7 +34,8 @@ def segment_detail(result: SimulationResult, index: int) -> dict:
     """A segment's target, start, end, reach time and overshoot (from the run's metrics); its
     settling time (:func:`~smafinger.metrics.settle_time`), when the joint comes to rest
     (:func:`~smafinger.metrics.rest_time`), when the wires it started with partly austenite are
-    back to martensite (``cooled_s``, :func:`~smafinger.metrics.cooled_time`), the angle at its
+    back to martensite (``cooled_s``, :func:`~smafinger.metrics.cooled_time`; 0 if none was),
+    the later of that and its reach time (``reached_cooled_s``), the angle at its
     end; and per wire when it got back to martensite and its peak duty."""
     seg = next(s for s in result.summary()["segments"] if s["index"] == index)
     t, th = result.t, result.signal("theta_deg")
@@ -45,6 +46,9 @@ def segment_detail(result: SimulationResult, index: int) -> dict:
     out["settle_s"] = M.settle_time(t, th, seg["target_deg"], a, b)
     out["rest_s"] = M.rest_time(t, result.signal("omega_deg_s"), a, b)
     out["cooled_s"] = M.cooled_time(t, xi, a, b)
+    # over when reached and cooled (cooled alone is 0 for a move that began all martensite)
+    out["reached_cooled_s"] = None if None in (out["reached_s"], out["cooled_s"]) else max(out["reached_s"],
+                                                                                          out["cooled_s"])
     out["final_deg"] = float(th[inside][-1])
     for w in WIRES:
         out[f"martensite_{w}_s"] = M.martensite_time(t, xi[w], a)

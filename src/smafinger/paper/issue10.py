@@ -22,7 +22,7 @@ STRATEGIES = tuple(STRATEGY_NAMES)
 MOVE_ENDS = (("reached_s", "reached (within tol_deg for hold_s)"),
              ("settle_s", "settled within 0.1 deg to the end of its 10 s"),
              ("rest_s", "at rest (below 0.05 deg/s) to the end of its 10 s"),
-             ("cooled_s", "the wires it began with partly austenite back to martensite"))
+             ("reached_cooled_s", "reached, and the wires it began with partly austenite back to martensite"))
 #: the variants of the per-move table (on the 10 s schedule runs)
 MOVE_VARIANTS = (AS_SPECIFIED, DEADBAND, FINE_STEP)
 #: the rows of the Fig. 15 table, in order (then smafinger 0.1's independent runs)
