@@ -66,14 +66,15 @@ def test_a_hotter_faster_candidate_ranks_below_a_cooler_slower_one(over_C):
 
 def test_a_tiny_tuning_end_to_end(tmp_path):
     out = tmp_path / "tuned.json"
-    r = CliRunner().invoke(app, ["tune", "pid", "-m", "linear-bias-spring", "-t", "sine-0.5hz", "--budget", "4",
+    r = CliRunner().invoke(app, ["tune", "pid", "-m", "linear-bias-spring", "-t", "sine-0.5hz", "--budget", "5",
                                  "--popsize", "2", "-w", "1", "--out", str(out), "--set", "K_I_per_q_s=100"])
     assert r.exit_code == 0, r.output
     doc = json.loads(out.read_text())
     # a field fixed with --set is left out of the default free fields (found by review: it was tuned
     # anyway and reported as fixed)
     assert set(doc["values"]) == {"K_P_per_q", "K_V_s_per_q"} and doc["fixed"] == ["K_I_per_q_s=100"]
-    assert doc["evaluations"] >= 4 and math.isfinite(doc["objective"])
+    # the budget holds when it is not a whole number of generations (it ran 6 candidates for 5)
+    assert doc["evaluations"] == 5 and len(doc["history"]) == 3 and math.isfinite(doc["objective"])
     # the best objective never gets worse from one generation to the next
     assert all(b <= a for a, b in zip(doc["history"], doc["history"][1:]))
 

@@ -221,12 +221,15 @@ def _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, po
                                              "maxfevals": budget, "verbose": -9})
     best = (math.inf, None, None)
     history, evaluations = [], 0
-    while not es.stop():
-        xs = es.ask()
+    while not es.stop() and evaluations < budget:
+        # the last generation cut to what is left of the budget (CMA-ES then learns nothing from
+        # it: its update needs a whole population; it may still hold the best candidate)
+        xs = es.ask()[:budget - evaluations]
         cands = [base.replace(**{f.name: f.value(u) for f, u in zip(free, x)}) for x in xs]
         all_scores = _scores(tasks, cands, strategy, pool)
         fs = [INVALID if s is None else objective(tasks, s, reference, limit) for s in all_scores]
-        es.tell(xs, fs)
+        if len(xs) == es.popsize:
+            es.tell(xs, fs)
         evaluations += len(xs)
         k = int(np.argmin(fs))
         if fs[k] < best[0]:
