@@ -45,9 +45,63 @@ def test_bad_duties_name_the_wire_and_value(duties, names):
     assert s.steps == []  # nothing applied
 
 
-def test_bad_session_settings():
-    with pytest.raises(ValueError, match="control_interval_s = 0"):
-        PlantSession("paper2010", control_interval_s=0)
+@pytest.mark.parametrize("kwargs, match", [
+    ({"control_interval_s": 0}, "control_interval_s = 0"),
+    ({"control_interval_s": True}, "control_interval_s = True"),  # was an interval of 1 s
+    ({"episode_s": True}, "episode_s = True"),
+    ({"control_interval_s": 0.0005}, "shorter than the plant's step"),  # named the engine's t_end_s
+    ({"episode_s": 0.25}, "episode_s = 0.25 is not a whole number"),  # ran 0.2 s
+    ({"episode_s": 0.04}, "episode_s = 0.04 is not a whole number"),  # was done at reset
+    ({"target": float("nan")}, "target = nan"),  # every reward NaN
+    ({"target": 1e6}, "target = 1000000.0 must be a finite number within"),
+    ({"temperature_sensors": "no"}, "temperature_sensors = 'no'"),  # turned the sensors on
+    ({"overrides": "V_H_V=9"}, "list of NAME=VALUE"),
+])
+def test_bad_session_settings_name_the_field_and_value(kwargs, match):
+    """Each was accepted and silently misread, or refused naming something else (found by review)."""
+    with pytest.raises(ValueError, match=match):
+        PlantSession("paper2010", **kwargs)
+
+
+def test_numpy_numbers_are_settings_too():
+    s = PlantSession("paper2010", control_interval_s=np.float32(0.25), episode_s=np.int64(1), target=np.float64(-30))
+    assert s.n_steps == 4 and s.target == -30.0
+
+
+def test_two_opposing_wires_asked_to_heat_get_the_interlock_not_a_crash():
+    """The engine refuses a program heating both wires; the session stored the step before the
+    run failed, so every later step failed too (found by review). The plant now drives the wire
+    with the larger duty (neither on a tie) and counts the step."""
+    s = PlantSession("paper2010", control_interval_s=0.2, episode_s=1.0)
+    s.reset()
+    s.step((0.6, 0.3))
+    assert s.last_step_cut and s.interlock_cuts == 1 and s.steps[-1] == (0.0, 0.6, 0.0)
+    s.step((0.0, 0.4))
+    assert not s.last_step_cut and s.steps[-1] == (0.2, 0.0, 0.4)
+    s.step((0.5, 0.5))
+    assert s.last_step_cut and s.interlock_cuts == 2 and s.steps[-1] == (0.4, 0.0, 0.0)
+    assert s.interlock_violations() == 0  # what the plant did: never both
+    lone = PlantSession("linear-bias-spring", control_interval_s=0.2, episode_s=1.0)
+    lone.reset()
+    lone.step((0.7,))
+    assert not lone.last_step_cut and lone.steps[-1] == (0.0, 0.7)
+
+
+def test_a_step_that_fails_leaves_the_session_as_it_was(monkeypatch):
+    import smafinger.bench.gym_env as g
+
+    s = PlantSession("paper2010", control_interval_s=0.2, episode_s=1.0)
+    s.reset()
+    s.step((0.5, 0.0))
+    before = (list(s.steps), s.result, s.interlock_cuts)
+
+    def fail(spec):
+        raise RuntimeError("blow-up")
+
+    monkeypatch.setattr(g, "run_spec", fail)
+    with pytest.raises(RuntimeError):
+        s.step((0.3, 0.6))
+    assert (s.steps, s.result, s.interlock_cuts) == before
 
 
 def test_gymnasium_env_passes_the_checker():
@@ -58,4 +112,31 @@ def test_gymnasium_env_passes_the_checker():
     check_env(env, skip_render_check=True)
     obs, _ = env.reset(seed=0)
     obs, reward, terminated, truncated, info = env.step(np.array([1.0]))
-    assert reward <= 0.0 and not truncated and gymnasium is not None
+    assert reward <= 0.0 and not truncated and not terminated and gymnasium is not None
+
+
+def test_the_joints_env_passes_the_checker_and_pays_for_the_interlock():
+    """check_env failed on the joint: its random actions heat both wires (found by review)."""
+    pytest.importorskip("gymnasium")
+    from gymnasium.utils.env_checker import check_env
+
+    env = make_env(params="paper2010", target=-30.0, control_interval_s=0.2, episode_s=0.4, interlock_penalty=5.0)
+    check_env(env, skip_render_check=True)
+    env.reset(seed=0)
+    _, r_both, _, _, info = env.step(np.array([0.5, 0.2]))
+    assert info["interlock_cut"]
+    env.reset(seed=0)
+    _, r_one, terminated, truncated, info = env.step(np.array([0.5, 0.0]))
+    assert not info["interlock_cut"] and r_one - r_both == pytest.approx(5.0)  # the same plant, the penalty
+    _, _, terminated, truncated, _ = env.step(np.array([0.0, 0.0]))
+    assert truncated and not terminated  # the time limit is a truncation (Gymnasium's API)
+
+
+@pytest.mark.parametrize("kwargs, match", [({"heat_penalty": float("nan")}, "heat_penalty = nan"),
+                                           ({"heat_penalty": -1.0}, "heat_penalty = -1.0 must be a finite number >= 0"),
+                                           ({"interlock_penalty": float("nan")}, "interlock_penalty = nan"),
+                                           ({"max_T_C": float("nan")}, "max_T_C = nan")])
+def test_bad_penalties_are_refused(kwargs, match):
+    pytest.importorskip("gymnasium")
+    with pytest.raises(ValueError, match=match):
+        make_env(params="paper2010", **kwargs)

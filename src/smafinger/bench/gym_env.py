@@ -13,20 +13,26 @@ steps of 0.1 s on the joint).
 ``pip install 'smafinger[gym]'``): action: a duty per wire in [0, 1]; observation: the
 measured signals and the target, in the order of :attr:`PlantSession.observation_names`;
 reward: minus the tracking error |q - q_F| (user unit) times the interval, less
-``heat_penalty`` per degC by which any wire exceeds ``max_T_C`` and ``interlock_penalty`` for
-a step that drives two opposing wires at once (the interlock of Sec. 2.6 is the policy's job
-here). A learned policy is then compared on the same plant and tasks as the built-in
-controllers (docs/controllers.md).
+``heat_penalty`` per degC by which any wire exceeds ``max_T_C`` at the end of a step (per step,
+not scaled by the interval) and ``interlock_penalty`` for a step whose action asks to heat two
+opposing wires at once. The plant never does: the interlock of Sec. 2.6 (the engine refuses a
+program that breaks it) drives only the wire with the larger duty, neither on a tie, and the
+step is counted (:attr:`PlantSession.interlock_cuts`). An episode ends by its time limit, which
+Gymnasium calls truncation (``truncated=True``, ``terminated=False``: the observation holds no
+clock, so the last state is not terminal); stepping on continues the plant. A learned policy is
+then compared on the same plant and tasks as the built-in controllers (docs/controllers.md).
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
 
 from ..engine.run import make_spec, run_spec
+from ..model.build import build_model
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
 from ..profiles import VoltageProgram
@@ -39,20 +45,33 @@ class PlantSession:
     def __init__(self, params: str | ParameterSet = "paper2010", target: float | None = None,
                  control_interval_s: float = 0.1, episode_s: float = 20.0, temperature_sensors: bool = False,
                  overrides: tuple[str, ...] = ()):
+        if isinstance(overrides, str) or not all(isinstance(o, str) for o in overrides):
+            raise ValueError(f"overrides = {overrides!r} must be a list of NAME=VALUE strings")
         p = get_params(params) if isinstance(params, str) else params
         self.params = p.with_overrides(list(overrides)) if overrides else p
-        for name, v in (("control_interval_s", control_interval_s), ("episode_s", episode_s)):
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} = {v!r} must be a finite number > 0")
-        self.dt = float(control_interval_s)
-        self.n_steps = int(round(episode_s / self.dt))
+        self.dt = _positive("control_interval_s", control_interval_s)
+        if self.dt < BENCH_NUMERICS["dt_s"]:
+            raise ValueError(f"control_interval_s = {control_interval_s!r} is shorter than the plant's step, "
+                             f"{BENCH_NUMERICS['dt_s']} s")
+        episode = _positive("episode_s", episode_s)
+        self.n_steps = int(round(episode / self.dt))
+        if self.n_steps < 1 or not math.isclose(self.n_steps * self.dt, episode, rel_tol=1e-9):
+            raise ValueError(f"episode_s = {episode_s!r} is not a whole number of control intervals of "
+                             f"{self.dt:g} s")
+        c = self.params.coordinate
+        if target is not None and not (_real(target) and math.isfinite(target) and abs(target) <= c.limit):
+            raise ValueError(f"target = {target!r} must be a finite number within +-{c.limit:g} {c.unit}")
         self.target = float(self.params.initial_target if target is None else target)
+        if not isinstance(temperature_sensors, (bool, np.bool_)):
+            raise ValueError(f"temperature_sensors = {temperature_sensors!r} must be True or False")
         self.temperature_sensors = bool(temperature_sensors)
         self.wires = tuple(self.params.wire_names)
-        c = self.params.coordinate
+        self._directions = tuple(w.direction for w in build_model(self.params).wires)
         self._q, self._v = f"{c.name}_{c.unit}", None
         self.steps: list[tuple[float, ...]] = []
         self.result = None
+        self.interlock_cuts = 0  #: steps whose duties the interlock cut (two opposing wires asked)
+        self.last_step_cut = False
 
     @property
     def observation_names(self) -> tuple[str, ...]:
@@ -63,6 +82,7 @@ class PlantSession:
 
     def reset(self) -> np.ndarray:
         self.steps, self.result = [], None
+        self.interlock_cuts, self.last_step_cut = 0, False
         return self.observe()
 
     @property
@@ -82,11 +102,25 @@ class PlantSession:
         for w, x in zip(self.wires, d):
             if not (math.isfinite(x) and 0.0 <= x <= 1.0):
                 raise ValueError(f"duty of wire {w} = {float(x)!r} must be in [0, 1]")
-        self.steps.append((self.t_s, *map(float, d)))
-        spec = make_spec(self.params, "open-loop", voltage=VoltageProgram(tuple(self.steps), "duty"),
-                         t_end_s=self.t_s, output_interval_s=self.dt, **BENCH_NUMERICS)
-        self.result = run_spec(spec)
+        applied, cut = self._interlocked(d)
+        steps = (*self.steps, (self.t_s, *applied))
+        spec = make_spec(self.params, "open-loop", voltage=VoltageProgram(steps, "duty"),
+                         t_end_s=len(steps) * self.dt, output_interval_s=self.dt, **BENCH_NUMERICS)
+        self.result = run_spec(spec)  # the session changes only once the step has run
+        self.steps.append(steps[-1])
+        self.last_step_cut = cut
+        self.interlock_cuts += cut
         return self.observe()
+
+    def _interlocked(self, d: np.ndarray) -> tuple[tuple[float, ...], bool]:
+        """The duties the plant applies: where wires pulling both ways are asked to heat, only
+        those of the direction with the larger duty (none on a tie); and whether that cut any."""
+        push = max((x for x, k in zip(d, self._directions) if k > 0), default=0.0)
+        pull = max((x for x, k in zip(d, self._directions) if k < 0), default=0.0)
+        if push == 0.0 or pull == 0.0:
+            return tuple(map(float, d)), False
+        keep = 1.0 if push > pull else -1.0 if pull > push else 0.0
+        return tuple(float(x) if k == keep else 0.0 for x, k in zip(d, self._directions)), True
 
     def signal(self, name: str) -> float:
         """The last sample of an output signal (0 before the first step, except the initial state)."""
@@ -117,7 +151,26 @@ class PlantSession:
         return max(self.signal(f"T_{w}_C") for w in self.wires) if self.result is not None else -math.inf
 
     def interlock_violations(self) -> int:
+        """The engine's count of drives of opposing wires at once (0: the session applies the
+        interlock; :attr:`interlock_cuts` counts the steps whose action asked for it)."""
         return int(self.result.interlock_violations) if self.result is not None else 0
+
+
+def _real(v) -> bool:
+    """A real number, not a bool (True is not an interval of 1 s)."""
+    return isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))
+
+
+def _positive(name: str, v) -> float:
+    if not (_real(v) and math.isfinite(v) and v > 0):
+        raise ValueError(f"{name} = {v!r} must be a finite number > 0")
+    return float(v)
+
+
+def _finite(name: str, v, low: float = -math.inf) -> float:
+    if not (_real(v) and math.isfinite(v) and v >= low):
+        raise ValueError(f"{name} = {v!r} must be a finite number" + (f" >= {low:g}" if low > -math.inf else ""))
+    return float(v)
 
 
 def make_env(**kwargs: Any):
@@ -129,9 +182,9 @@ def make_env(**kwargs: Any):
     except ImportError:
         raise ImportError("the Gymnasium environment needs the optional extra: pip install 'smafinger[gym]'") from None
 
-    max_T = float(kwargs.pop("max_T_C", 110.0))
-    heat_w = float(kwargs.pop("heat_penalty", 1.0))
-    lock_w = float(kwargs.pop("interlock_penalty", 1.0))
+    max_T = _finite("max_T_C", kwargs.pop("max_T_C", 110.0))
+    heat_w = _finite("heat_penalty", kwargs.pop("heat_penalty", 1.0), 0.0)
+    lock_w = _finite("interlock_penalty", kwargs.pop("interlock_penalty", 1.0), 0.0)
 
     class SMAPlantEnv(gymnasium.Env):
         metadata = {"render_modes": []}
@@ -149,11 +202,12 @@ def make_env(**kwargs: Any):
 
         def step(self, action):
             s = self.session
-            before = s.interlock_violations()
             obs = s.step(np.clip(np.asarray(action, dtype=float), 0.0, 1.0))
             reward = -abs(obs[0] - s.target) * s.dt
             reward -= heat_w * max(0.0, s.hottest_T_C() - max_T)
-            reward -= lock_w * (s.interlock_violations() > before)
-            return obs, float(reward), s.done, False, {"t_s": s.t_s, "hottest_T_C": s.hottest_T_C()}
+            reward -= lock_w * s.last_step_cut
+            # the time limit: truncation, not a terminal state (module docstring)
+            return obs, float(reward), False, s.done, {"t_s": s.t_s, "hottest_T_C": s.hottest_T_C(),
+                                                       "interlock_cut": s.last_step_cut}
 
     return SMAPlantEnv()
