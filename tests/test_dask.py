@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import math
 import os
 import signal
 import socket
@@ -154,5 +155,63 @@ def test_worker_count_is_read_live(cluster):
         assert pool.slots == 2 and "(2 worker threads)" in pool.describe()
         pool._slots_at = -1e9  # as if a second had passed
         assert pool.slots == sum(pool.client.nthreads().values())
+    finally:
+        pool.close()
+
+
+@pytest.mark.parametrize("timeout", [math.inf, 1e300, math.nan])
+def test_an_endless_connect_timeout_is_bad_input(timeout):
+    """inf and 1e300 gave an internal error (OverflowError) with exit status 1 (found by review)."""
+    with pytest.raises(batch.SchedulerError, match="--connect-timeout .*at most 86400"):
+        batch.DaskPool("tcp://127.0.0.1:9", timeout_s=timeout)
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_a_cluster_without_workers_says_so_instead_of_waiting_silently(monkeypatch):
+    """A sweep on a cluster with no worker (or that lost them all) waited for ever without a
+    word (found by review). The pool now says every IDLE_REPORT_S that no task finishes and how
+    many worker threads the cluster has; and it removes its worker plugin when it closes (a
+    worker joining later loaded it and, without smafinger, hung the next sweep)."""
+    from smafinger.engine import dask_pool
+
+    monkeypatch.setattr(dask_pool, "IDLE_POLL_S", 0.1)
+    monkeypatch.setattr(dask_pool, "IDLE_REPORT_S", 0.3)
+    with distributed.LocalCluster(n_workers=0, processes=True, host="127.0.0.1", dashboard_address=None,
+                                  silence_logs=logging.CRITICAL) as empty:
+        pool = batch.DaskPool(empty.scheduler_address)
+        texts = []
+
+        def on_idle(text):
+            texts.append(text)
+            if len(texts) == 2:
+                raise _Stop
+
+        pool.on_idle = on_idle
+        try:
+            assert dask_pool.PLUGIN_NAME in empty.scheduler.worker_plugins
+            with pytest.raises(_Stop):
+                list(pool.map_tasks(abs, [-1, -2]))
+        finally:
+            pool.close()
+        assert dask_pool.PLUGIN_NAME not in empty.scheduler.worker_plugins
+    assert texts[0].startswith("no Dask task has finished for 0 s: the cluster has 0 worker threads; waiting for "
+                               "workers (Ctrl-C stops; finished runs are kept)"), texts
+    assert len(texts) == 2
+
+
+def test_a_worker_of_another_version_is_refused_by_its_tasks(cluster):
+    """The version was checked only at the start: a worker that joined later with another
+    smafinger wrote 30 of 120 rows of a sweep whose provenance named the client's version
+    (found by review). Each task now checks its worker's version."""
+    pool = batch.DaskPool(cluster.scheduler_address)
+    try:
+        assert list(pool.map_tasks(abs, [-3])) == [3]
+        pool._version = "0.0.0-not-this-one"  # as if every worker had joined with another version
+        with pytest.raises(batch.BatchError, match=r"a Dask worker runs smafinger \S+, the client 0.0.0-not-this-one: "
+                                                   "install the same version on every worker; finished runs are kept"):
+            list(pool.map_tasks(abs, [-3]))
     finally:
         pool.close()

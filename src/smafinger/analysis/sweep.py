@@ -236,7 +236,7 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     try:
         if scheduler is not None or total > CHECK_HERE_MAX:
             pool = batch.make_pool(workers, scheduler, connect_timeout_s)
-            say.pool(pool)
+            say.watch(pool)
         checked = check_points(spec, template, points, pool or batch.SerialPool(), traced)
         clean_stale(out)
         index = IdIndex(checked.ids)
@@ -251,7 +251,8 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
         if ran:
             if pool is None:
                 pool = batch.make_pool(workers, scheduler, connect_timeout_s)
-                say.pool(pool)
+                say.watch(pool)
+            say.pool(pool)  # after the check pass: a bad point's error stays one line
             backend = pool.describe()
             say.line(f"running {ran} runs on {backend}")
             size = chunk_size or spec.chunk_size or batch.auto_chunk_size(ran, pool.slots)

@@ -23,6 +23,11 @@ class Progress:
     def line(self, text: str) -> None:
         self.display.line(text)
 
+    def watch(self, pool) -> None:
+        """A pool that reports waits (a Dask cluster with no task finishing) reports them here."""
+        if hasattr(pool, "on_idle") and self.display.mode != "off":
+            pool.on_idle = self.line
+
     def pool(self, pool) -> None:
         link = getattr(pool, "dashboard_link", None)
         if link:

@@ -8,11 +8,50 @@ line naming the address.
 
 from __future__ import annotations
 
+import math
 import os
 import time
+import warnings
 
 from .pools import (CONNECT_TIMEOUT_S, IN_FLIGHT_PER_SLOT, BatchError, SchedulerError, SerialPool, _END,
                     _import_distributed, is_warm, warm_up)
+
+
+#: how often the pool looks whether a task has finished while none has
+IDLE_POLL_S = 1.0
+#: with no task finished for this long, the pool says what the cluster has (then again as long)
+IDLE_REPORT_S = 30.0
+#: the longest --connect-timeout taken (a day)
+MAX_CONNECT_TIMEOUT_S = 86400.0
+#: the name of the worker plugin that loads the kernel on every worker (removed at the end)
+PLUGIN_NAME = "smafinger-warm-up"
+
+
+class WorkerVersionError(BatchError):
+    """A worker runs another smafinger version than the client (one that joined after the start)."""
+
+
+def checked_task(fn, item, version: str):
+    """``fn(item)`` on a worker, once it is known to run the client's smafinger ``version``: a
+    worker that joins the cluster after the pool's start is checked here, by each task."""
+    import smafinger
+
+    if smafinger.__version__ != version:
+        raise WorkerVersionError(f"a Dask worker runs smafinger {smafinger.__version__}, the client {version}")
+    return fn(item)
+
+
+def _finished(ac, timeout_s: float) -> list:
+    """The futures ``ac`` (an ``as_completed``) has finished, waiting at most ``timeout_s`` for
+    one (on the condition its own blocking iteration waits on, a tenth of a second at a time)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        done = ac.next_batch(block=False)
+        left = deadline - time.monotonic()
+        if done or left <= 0:
+            return done
+        with ac.thread_condition:
+            ac.thread_condition.wait(timeout=min(0.1, left))
 
 
 def parse_scheduler_address(address: str) -> tuple[str, str, int | None]:
@@ -51,8 +90,9 @@ def check_scheduler(address: str, timeout_s: float = CONNECT_TIMEOUT_S) -> str:
     import asyncio
     import socket
 
-    if not (isinstance(timeout_s, (int, float)) and timeout_s > 0):
-        raise SchedulerError(f"--connect-timeout {timeout_s!r}: must be a number of seconds > 0")
+    if not (isinstance(timeout_s, (int, float)) and 0 < timeout_s <= MAX_CONNECT_TIMEOUT_S):
+        raise SchedulerError(f"--connect-timeout {timeout_s!r}: must be a number of seconds > 0 and at most "
+                             f"{MAX_CONNECT_TIMEOUT_S:g}")
     try:
         scheme, host, port = parse_scheduler_address(address)
     except ValueError as exc:
@@ -79,7 +119,11 @@ def check_scheduler(address: str, timeout_s: float = CONNECT_TIMEOUT_S) -> str:
     left = max(0.1, timeout_s - (time.monotonic() - t0))
     try:
         reply = asyncio.run(asyncio.wait_for(identity(), left))
-    except (asyncio.TimeoutError, TimeoutError):
+    except (asyncio.TimeoutError, TimeoutError, OSError) as exc:
+        # distributed's own connect gives up with an OSError "Timed out trying to connect ..."
+        if not isinstance(exc, TimeoutError) and "timed out" not in str(exc).lower():
+            raise SchedulerError(f"{shown} is not a Dask scheduler ({type(exc).__name__}: "
+                                 f"{str(exc).splitlines()[0] if str(exc) else ''})") from None
         raise SchedulerError(f"{shown} accepts connections but is not a Dask scheduler "
                              f"(no answer within {timeout_s:g} s; see --connect-timeout)") from None
     except Exception as exc:  # noqa: BLE001 - any failure of the handshake is one line
@@ -101,7 +145,7 @@ def __getattr__(name: str):
         class WarmUpPlugin(distributed.WorkerPlugin):
             """Loads the numba kernel once per worker, when the worker starts."""
 
-            name = "smafinger-warm-up"
+            name = PLUGIN_NAME
 
             def setup(self, worker):  # noqa: D401
                 warm_up()
@@ -131,9 +175,16 @@ class DaskPool(SerialPool):
     """
 
     def __init__(self, address, timeout_s: float = CONNECT_TIMEOUT_S):
+        import smafinger
+
         distributed = _import_distributed()
         self._distributed = distributed
         self._slots, self._slots_at = 1, -1e9
+        self._version = smafinger.__version__
+        self._plugin = False
+        #: called with a line of text while no task finishes (:data:`IDLE_REPORT_S`); a sweep
+        #: sets its progress display's line, else a Python warning
+        self.on_idle = lambda text: warnings.warn(text, RuntimeWarning, stacklevel=2)
         if isinstance(address, distributed.Client):
             self.client = address
             self._own = False
@@ -148,28 +199,33 @@ class DaskPool(SerialPool):
         self.address = getattr(self.client.scheduler, "address", str(address))
         warm_up()  # refreshes numba's disk cache, which workers on this machine then load
         try:
-            self.client.register_plugin(__getattr__("WarmUpPlugin")(), name="smafinger-warm-up")
+            self.client.register_plugin(__getattr__("WarmUpPlugin")(), name=PLUGIN_NAME)
+            self._plugin = True
             info = self.client.run(_worker_info)
         except Exception as exc:
             self.close()
             raise BatchError(f"the Dask workers cannot run smafinger ({type(exc).__name__}: {exc}); "
                              "install smafinger on every worker") from None
-        import smafinger
-
-        bad = {w: i["version"] for w, i in info.items() if i["version"] != smafinger.__version__}
+        bad = {w: i["version"] for w, i in info.items() if i["version"] != self._version}
         if bad:
             self.close()
-            raise BatchError(f"the Dask workers run other smafinger versions than {smafinger.__version__}: {bad}")
+            raise BatchError(f"the Dask workers run other smafinger versions than {self._version}: {bad}")
+
+    def threads(self) -> int | None:
+        """Worker threads in the cluster now (0: none; None: the scheduler does not answer)."""
+        try:
+            return sum(self.client.nthreads().values())
+        except Exception:  # noqa: BLE001 - a scheduler that is going away
+            return None
 
     @property
     def slots(self) -> int:
-        """Worker threads in the cluster now (at least 1; asked again after 1 s)."""
+        """Worker threads in the cluster now, for sizing (at least 1; asked again after 1 s)."""
         now = time.monotonic()
         if now - self._slots_at > 1.0:
-            try:
-                self._slots = max(1, sum(self.client.nthreads().values()))
-            except Exception:  # noqa: BLE001 - a scheduler that is going away keeps the last count
-                pass
+            n = self.threads()
+            if n is not None:  # a scheduler that is going away keeps the last count
+                self._slots = max(1, n)
             self._slots_at = now
         return self._slots
 
@@ -184,7 +240,13 @@ class DaskPool(SerialPool):
         return f"Dask scheduler {self.address} ({self.slots} worker threads)"
 
     def map_tasks(self, fn, items):
-        """Yield each task's result as soon as it finishes; a few tasks per worker in flight."""
+        """Yield each task's result as soon as it finishes; a few tasks per worker in flight.
+
+        Each task first checks its worker's smafinger version (:func:`checked_task`). While no
+        task finishes, :attr:`on_idle` is told every :data:`IDLE_REPORT_S` how many worker
+        threads the cluster has (a cluster with none, or that lost them all, waits for workers:
+        an adaptive cluster starts them on demand).
+        """
         it = iter(items)
         ac = self._distributed.as_completed([], loop=self.client.loop)
         live: set = set()
@@ -194,25 +256,53 @@ class DaskPool(SerialPool):
                 item = next(it, _END)
                 if item is _END:
                     return
-                f = self.client.submit(fn, item, pure=False)
+                f = self.client.submit(checked_task, fn, item, self._version, pure=False)
                 live.add(f)
                 ac.add(f)
 
         try:
             fill()
-            for f in ac:
-                live.discard(f)
-                try:
-                    res = f.result()
-                except Exception as exc:  # KilledWorker and the like
-                    raise BatchError(f"a Dask task failed ({type(exc).__name__}: {exc}); finished runs are kept") from None
-                f.release()
+            idle_since, report_at = time.monotonic(), IDLE_REPORT_S
+            while live:
+                done = _finished(ac, IDLE_POLL_S)
+                if not done:
+                    waited = time.monotonic() - idle_since
+                    if waited >= report_at:
+                        report_at += IDLE_REPORT_S
+                        self.on_idle(self._idle_text(waited))
+                    continue
+                idle_since, report_at = time.monotonic(), IDLE_REPORT_S
+                for f in done:
+                    live.discard(f)
+                    try:
+                        res = f.result()
+                    except WorkerVersionError as exc:
+                        raise BatchError(f"{exc}: install the same version on every worker; finished runs are "
+                                         "kept") from None
+                    except Exception as exc:  # KilledWorker and the like
+                        first = str(exc).splitlines()[0] if str(exc) else ""
+                        raise BatchError(f"a Dask task failed ({type(exc).__name__}: {first}); finished runs are "
+                                         "kept") from None
+                    f.release()
+                    yield res
                 fill()
-                yield res
         finally:
             if live:
                 self.client.cancel(list(live))
 
+    def _idle_text(self, waited_s: float) -> str:
+        n = self.threads()
+        has = ("the scheduler does not answer" if n is None else
+               f"the cluster has {n} worker thread{'s' if n != 1 else ''}")
+        wait = "; waiting for workers (Ctrl-C stops; finished runs are kept)" if not n else ""
+        return f"no Dask task has finished for {math.floor(waited_s):d} s: {has}{wait}"
+
     def close(self, cancel: bool = False) -> None:
+        if self._plugin:  # a worker joining later must not load this client's plugin
+            try:
+                self.client.unregister_worker_plugin(PLUGIN_NAME)
+            except Exception:  # noqa: BLE001 - a scheduler that is gone has no plugin left
+                pass
+            self._plugin = False
         if self._own:
             self.client.close()
