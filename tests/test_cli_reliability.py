@@ -110,7 +110,17 @@ def test_a_blow_up_says_what_to_change(capsys):
     rc, _, err = run(capsys, "simulate", "--params", "paper2010-table2", "--set", "inertia_kg_m2=1e-9", "--strategy",
                      "open-loop", "--voltage", "0:8:0,10:0:0", "--method", "euler", "--t-end", "20", "--no-progress")
     assert rc == 1 and len(err) == 1 and err[0].startswith("smafinger: simulation failed: numerical blow-up at t = ")
-    assert "try a smaller --dt (now 0.001 s) or --method rk4; check inertia_kg_m2 = 1e-09" in err[0]
+    assert ("euler is stable only up to dt = 0.0001 ms against this set's damping (2e+07 1/s; now 1 ms): use a "
+            "smaller --dt or --method exponential; check inertia_kg_m2 = 1e-09") in err[0]
+
+
+def test_a_blow_up_of_an_explicit_step_names_its_stability_limit(capsys):
+    """rk4 at 10 ms blows up on the paper's joint (C_DF / I = 1844 1/s); the hint said only 'try
+    a smaller --dt', not how small, nor that the output interval had hidden it (exact PWM steps
+    end at every sample: with 1 ms samples the same command runs 1 ms steps)."""
+    rc, _, err = run(capsys, "simulate", "--strategy", "open-loop", "--voltage", "0:8:0,8:0:0", "--t-end", "20",
+                     "--method", "rk4", "--dt", "0.01", "--pwm", "exact", "--output-interval", "0.1", "--no-progress")
+    assert rc == 1 and "rk4 is stable only up to dt = 1.5 ms against this set's damping (1844 1/s; now 10 ms)" in err[0]
 
 
 def test_json_times_carry_no_float_noise(here, capsys):

@@ -112,11 +112,30 @@ def extreme_parameters(params) -> list[str]:
     return [text for factor, text in sorted(found, key=lambda x: -x[0]) if math.isfinite(factor)]
 
 
+#: |lambda dt| up to which each explicit integrator is stable on a real, negative mode (the
+#: damping's): Euler 2, classical RK4 2.785 (its stability region on the negative real axis)
+EXPLICIT_STABILITY = {"euler": 2.0, "rk4": 2.785, "authors-ode4": 2.785}
+
+
+def damping_rate_per_s(params) -> float:
+    """The mechanism's stiffest mode, its viscous damping over its inertia [1/s]: C_DF / I of
+    Eq. (2) for the joint (the larger of heating and cooling), c / m for the slider."""
+    if params.mechanism == "joint":
+        return max(params.C_DF_heating_Nms, params.C_DF_cooling_Nms) / params.inertia_kg_m2
+    return params.viscous_damping_N_s_m / params.slider_mass_kg
+
+
 def blowup_hint(spec) -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
-    hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
-    if spec.method != "rk4":
-        hint += " or --method rk4"
+    limit = EXPLICIT_STABILITY.get(spec.method)
+    rate = damping_rate_per_s(spec.params)
+    if limit is not None and rate * spec.dt_s > limit:
+        hint = (f"{spec.method} is stable only up to dt = {limit / rate * 1e3:.2g} ms against this set's damping "
+                f"({rate:.4g} 1/s; now {spec.dt_s * 1e3:g} ms): use a smaller --dt or --method exponential")
+    else:
+        hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
+        if spec.method != "rk4":
+            hint += " or --method rk4"
     extreme = extreme_parameters(spec.params)
     if extreme:
         hint += f"; check {extreme[0]}"
