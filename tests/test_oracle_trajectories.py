@@ -98,19 +98,47 @@ def test_heating_value_damping():
     assert err["q"] <= math.radians(0.05), err
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "engine/substep.py _update_kinetics passes the state's stress rate k1.sigma_Pa to drive_direction; "
-    "with the algebraic law that rate is 0 (the stress is no state), so tau = T - sigma/c is taken to "
-    "move with T alone (docs/hysteresis.md: the direction is tau's): an unheated wire at constant T "
-    "never leaves its first hold"))
 def test_memory_rule_follows_the_algebraic_stress():
     """authors2020's algebraic law with the memory rule, both wires at 80 degC (inside the A band).
 
     The lower wire is not heated: only its stress moves its tau. At its first motion xi_init = 1
     (above the major loop there) goes onto the major heating curve, then follows its stress.
-    Measured: the lower wire's xi stays 1.0 in the model (oracle: 0.965), q differs by 0.76 deg.
+    The engine took the direction from the state's stress rate, 0 under the algebraic law (the
+    stress is no state): the lower wire's xi stayed 1.0 (oracle: 0.965) and q differed by 0.76
+    deg. It now takes the solved stress's rate (Eq. 7b there): 0.011 deg and 2.8e-6.
     """
     p = get("authors2020").replace(hysteresis="memory", T_amb_C=80.0, T_init_C=80.0)
     err, ref = trajectory_errors(p, "0:8:0,3:0:0", "voltage", 6.0)
     assert ref.wires["lower"]["xi"].min() < 0.97 and ref.info["by_kind"].get("start", 0) >= 1
-    assert err["q"] <= math.radians(0.05) and err["xi"] <= 1e-4, err
+    r = simulate(p, "open-loop", voltage="0:8:0,3:0:0", t_end_s=6.0, dt_s=1e-3, method="rk4", output_interval_s=0.01)
+    lower = np.abs(r.wires["xi"][:, 1] - ref.wires["lower"]["xi"])
+    upper = np.abs(r.wires["xi"][1:, 0] - ref.wires["upper"]["xi"][1:])
+    assert err["q"] <= math.radians(0.05) and lower.max() <= 1e-4 and upper.max() <= 1e-4, err
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the first sample of a heated wire that starts outside the major loop under the algebraic law: "
+    "the engine places xi_init = 1 at 80 degC onto the heating curve at 0.97188, the oracle at 0.97233 "
+    "(later samples agree within 1.5e-6; found while fixing the direction above, not yet traced)"))
+def test_the_first_sample_outside_the_loop_matches_the_oracle():
+    p = get("authors2020").replace(hysteresis="memory", T_amb_C=80.0, T_init_C=80.0)
+    err, _ = trajectory_errors(p, "0:8:0,3:0:0", "voltage", 6.0)
+    assert err["xi"] <= 1e-4, err
+
+
+def test_the_linear_rigs_xi_follows_the_memory_rule_on_its_own_path():
+    """The linear rig (algebraic law, memory rule) in closed loop: tau = T - sigma/c moves against
+    T in about a tenth of the samples, and the engine followed T (found by review: xi 0.590
+    where the memory operator on the engine's own (T, sigma) path gives 0.432). The operator on
+    the sampled path now agrees to 6.3e-4 (the samples miss the sub-steps between them)."""
+    from smafinger.model.hysteresis import KineticsMaterial
+    from smafinger.model.hysteresis_drive import xi_history
+
+    r = simulate(SLIDER, "cooperative", profile="0:0.010,4:0.004,8:0.015", t_end_s=12.0, dt_s=1e-3, method="rk4",
+                 pwm="exact")
+    T, S, xi = (np.asarray(r.signal(n)) for n in ("T_wire_C", "sigma_wire_Pa", "xi_wire"))
+    m = KineticsMaterial(SLIDER.A_S0_C, SLIDER.A_F0_C, SLIDER.M_S0_C, SLIDER.M_F0_C, SLIDER.c_A_Pa_per_C,
+                         SLIDER.c_M_Pa_per_C)
+    tau = T - S / SLIDER.c_A_Pa_per_C
+    assert np.sum(np.sign(np.diff(tau)) * np.sign(np.diff(T)) < 0) > 1000  # exercised
+    assert np.max(np.abs(xi_history(T, S, m, xi_init=SLIDER.xi_init).xi - xi)) < 2e-3

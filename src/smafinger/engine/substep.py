@@ -15,7 +15,7 @@ from ..model.dynamics import at_stop_holding, end_stop, stick_slip
 from ..model.hysteresis import AUTHORS2020, DEADBAND, MEMORY, drive_direction, initial_record, update_memory
 from ..model.hysteresis_authors import initial_calls_record
 from ..model.records import Inputs, State, WireInput, WireState
-from ..model.wire import transformation_catch_up
+from ..model.wire import algebraic_stress_rate, transformation_catch_up
 from ..parameters.options import FrictionSticking, Hysteresis, StressLaw
 from .authors import Stages, call_branches, commit_calls
 from .clock import TICKS_PER_S
@@ -103,19 +103,26 @@ def _any(flags):
 
 
 @njit(cache=True, forceinline=True)
-def _update_kinetics(model, y, inputs, k1, aux, stacks):
+def _update_kinetics(model, y, inputs, geom, k1, aux, stacks):
     """Each wire's kinetics branch for the sub-step, from the derivatives at its start (Eqs. 9-10).
 
     The direction (tau = T - sigma/c rising, falling or neither; the legacy rules: the sign of
-    dT/dt) comes from k1; the memory commits the wipe-outs and reversals at the current point.
+    dT/dt) comes from k1: the stress rate of the state under the rate law, that of the solved
+    stress under the algebraic law (:func:`~smafinger.model.wire.algebraic_stress_rate`; the
+    state's is 0 there); the memory commits the wipe-outs and reversals at the current point.
     Returns (inputs, moved): ``moved[i]`` if wire i's branch must be evaluated anew.
     """
     wis = inputs.wires
     moved = filled(wis, False)
+    algebraic = model.options.stress_law == StressLaw.ALGEBRAIC
     for i in range(len(wis)):
         wi = wis[i]
         wire = model.wires[i]
-        d = drive_direction(wi.branch, k1.wires[i].T_C, k1.wires[i].sigma_Pa, wire)
+        dsigma = k1.wires[i].sigma_Pa
+        if algebraic and wi.branch.rule == MEMORY:  # the legacy rules read dT/dt alone
+            dsigma = algebraic_stress_rate(wire, y.wires[i].T_C, aux.wires[i].sigma_Pa, wi.branch,
+                                           k1.wires[i].T_C, geom.routes[i].dpath_dq * y.v)
+        d = drive_direction(wi.branch, k1.wires[i].T_C, dsigma, wire)
         rec, depth = update_memory(wi.branch, stacks[i], wi.depth, y.wires[i].T_C, aux.wires[i].sigma_Pa, d,
                                    wire)
         moved = set_item(moved, i, _branch_moved(wi.branch, rec))
@@ -245,7 +252,7 @@ def decide(model, run, y, inputs, geom, geom_q, cmds, s, viscous, integrating, a
             kinetics_done = True
             if calls:
                 inputs = commit_calls(model, y, inputs, aux)
-            inputs, redo = _update_kinetics(model, y, inputs, k1, aux, stacks)
+            inputs, redo = _update_kinetics(model, y, inputs, geom, k1, aux, stacks)
             if _any(redo):
                 continue
         redo = filled(model.wires, True)  # a stick/slip change: v and the mechanism's rates

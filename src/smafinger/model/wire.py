@@ -95,6 +95,17 @@ def wire_stress_xi(wire, ws, branch, path, stress_law):
 
 
 @njit(cache=True, forceinline=True)
+def algebraic_stress_rate(wire, T, sigma, branch, dT_dt, dpath_dt):
+    """The stress rate of the algebraic law at its solution ``sigma``: Eq. (7b)'s dsigma/dt there
+    (with dxi/dt = xi_T T' + xi_sigma sigma' on ``branch``) for path rate ``dpath_dt`` [m/s]
+    (Eq. 6). The stress is no state under that law, so the state's rate is 0; this is the rate
+    tau = T - sigma/c moves with, which the kinetics' direction needs (MODEL-NOTES)."""
+    xi, xT, xs = xi_on_branch(branch, T, sigma, wire)
+    D_eq = rate_law_modulus(wire, sigma, youngs_modulus(xi, wire.D_A_Pa, wire.D_M_Pa))[0]
+    return stress_rate(D_eq, dpath_dt / wire.wire_length_m, wire.eps_R, xT, xs, dT_dt, sigma)
+
+
+@njit(cache=True, forceinline=True)
 def _strain_driven(wire, dT0, D_eq, deps, xT, xs, sigma):
     """(dT/dt, dsigma/dt, dxi/dt) of the rate law at strain rate ``deps`` (Eqs. 7b, 11 with the
     latent heat): T' and sigma' solved together, dxi/dt = xi_T T' + xi_sigma sigma'."""
