@@ -46,6 +46,12 @@ def test_cross_checks():
         get("paper2010").replace(spring_length_upper_m=5e-3, spring_init="given")
     with pytest.raises(ParameterError, match="stress_law"):
         get("paper2010").replace(stress_law="magic")
+    # a major loop empty at zero stress (the kinetics refuse it; the set ran it, with 406 loop
+    # violations and no warning: found by review)
+    with pytest.raises(ParameterError, match="A_F0_C = 110.0 must exceed M_S0_C = 115.0"):
+        get("paper2010").replace(M_S0_C=115.0)
+    with pytest.raises(ParameterError, match="A_S0_C = 55.0 must exceed M_F0_C = 60.0"):
+        get("paper2010").replace(A_S0_C=55.0)
 
 
 def test_an_upper_spring_length_the_equilibrium_start_ignores_is_refused():

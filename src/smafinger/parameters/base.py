@@ -138,6 +138,12 @@ class ParameterSet:
             raise ParameterError(f"A_S0_C = {self.A_S0_C} must be below A_F0_C = {self.A_F0_C}")
         if not self.M_F0_C < self.M_S0_C:
             raise ParameterError(f"M_F0_C = {self.M_F0_C} must be below M_S0_C = {self.M_S0_C}")
+        from ..model.hysteresis import material_from_parameters
+
+        try:  # the kinetics' own rule: a major loop that is not empty at zero stress
+            material_from_parameters(self)
+        except ValueError as exc:
+            raise ParameterError(f"{exc} (the major hysteresis loop would be empty)") from None
         if self.V_L_V > self.V_H_V:
             raise ParameterError(f"V_L_V = {self.V_L_V} must not exceed V_H_V = {self.V_H_V}")
         if self.T_init_C < self.T_amb_C - 100.0:
