@@ -249,3 +249,15 @@ def test_a_low_level_that_heats_both_wires_is_warned_of():
     assert (hot.V_upper_V == 6.0).all() and (hot.V_lower_V == 6.0).all() and hot.interlock_violations == 0
     assert [w for w in hot.summary()["warnings"] if w.startswith("V_L_V = 6 V drives every wire")]
     assert not simulate("paper2010", "cooperative", "0:-40:none", t_end_s=5.0, method="rk4").summary()["warnings"]
+
+
+def test_a_start_outside_the_major_loop_is_warned_of():
+    """xi_init = 1 at 100 degC cooling towards 23 degC: the kinetics place it onto the loop at
+    t = 0 (0.234), silently (found by review). A set whose start is inside gets no warning."""
+    hot = simulate(get("paper2010").replace(T_init_C=100.0), strategy="open-loop", voltage="0:0:0", t_end_s=1.0)
+    xi0 = float(hot.signal("xi_upper")[0])
+    assert 0.2 < xi0 < 0.3
+    assert any(w.startswith("upper wire: xi_init = 1 lies outside the major hysteresis loop at T_init_C = 100 degC")
+               and f"starts from xi = {xi0:.4g}" in w for w in hot.summary()["warnings"])
+    cold = simulate("paper2010", strategy="open-loop", voltage="0:8:0", t_end_s=1.0)
+    assert not any("outside the major hysteresis loop" in w for w in cold.summary()["warnings"])

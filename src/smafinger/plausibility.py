@@ -12,7 +12,10 @@ survives either. :func:`check` flags, per wire:
   NiTi actuator wire in repeated use;
 - **overstrain**: the wire's strain ``sigma / D(xi) + xi eps_R`` (Eq. 7a with theta_T = 0)
   beyond the recoverable strain eps_R by more than :data:`STRAIN_MARGIN`: the wire would
-  deform plastically, which the model does not describe.
+  deform plastically, which the model does not describe;
+- **a start outside the loop**: ``xi_init`` outside the major hysteresis loop at ``T_init_C``
+  (say fully martensite at 100 degC): the kinetics place it on the loop at t = 0, so the run
+  starts from another xi than the set names.
 
 The warnings go into the run's metrics (``warnings``: a list of one-line texts) and so into
 every summary; the command line prints them.
@@ -29,6 +32,8 @@ OVERHEAT_MARGIN_C = 100.0
 STRESS_RATING_PA = 200e6
 #: overstrain: this far beyond eps_R [-] (1 % strain)
 STRAIN_MARGIN = 0.01
+#: a first sample of xi this far from xi_init: the start was placed onto the major loop
+XI_START_TOLERANCE = 1e-6
 
 
 def austenite_finish_C(sigma_Pa: np.ndarray, A_F0_C: float, c_A_Pa_per_C: float) -> np.ndarray:
@@ -59,6 +64,10 @@ def check(result) -> list[str]:
     out = []
     for w in p.wire_names:
         T, sigma, xi = (result.signal(n) for n in (f"T_{w}_C", f"sigma_{w}_Pa", f"xi_{w}"))
+        if abs(float(xi[0]) - p.xi_init) > XI_START_TOLERANCE:
+            out.append(f"{w} wire: xi_init = {p.xi_init:g} lies outside the major hysteresis loop at T_init_C = "
+                       f"{p.T_init_C:g} degC and the initial stress; the run starts from xi = {float(xi[0]):.4g} "
+                       "(the loop's bound there)")
         over, at = _peak(T - austenite_finish_C(sigma, p.A_F0_C, p.c_A_Pa_per_C), t)
         if over > OVERHEAT_MARGIN_C:
             out.append(f"{w} wire: {np.nanmax(T):.0f} degC, {over:.0f} degC above its austenite finish "
