@@ -35,6 +35,10 @@ CASES = {
     "linear-rig-long-step": lambda: make_spec("linear-bias-spring", "open-loop", voltage="0:0.6,3:0", drive="duty",
                                               t_end_s=6.0),
     "euler": lambda: make_spec("paper2010", "cooperative", "0:-25", t_end_s=3.0, method="euler", dt_s=2e-4),
+    # a soft spring, sharply stiffened: the spring's Newton start overflows sinh (interpreted: an
+    # OverflowError reported as a blow-up where the compiled run went on; found by review)
+    "stiff-slack": lambda: make_spec(get("paper2010").replace(slack_penalty_per_mm=10.0, spring_K_N_m=10.0),
+                                     "cooperative", "0:-25,reach:-55,reach:-40", t_end_s=4.0),
 }
 
 

@@ -17,6 +17,10 @@ import math
 from ..jit import njit
 
 
+#: the largest argument of sinh and cosh that does not overflow a float: ln(2 * DBL_MAX)
+SINH_MAX_ARG = 710.4758600739439
+
+
 @njit(cache=True, forceinline=True)
 def youngs_modulus(xi, D_A, D_M):
     """D = D_A + xi (D_M - D_A) (Eq. 7a)."""
@@ -66,7 +70,11 @@ def _stiffened_elongation(F, K_S, x_limit, fact, x):
     Newton from the linear guess (a few iterations where the slack has not stiffened the spring
     much); far up the cosh stiffening Newton from there moves too little per iteration, so if it
     has not converged in 60 the root is bracketed and found by bisection-safeguarded Newton.
+    A guess so far up that sinh overflows goes to the bracket at once (compiled, the overflow
+    gave inf and Newton NaN, which ended there too; plain Python raised OverflowError).
     """
+    if fact * 1000.0 * (x - x_limit) > SINH_MAX_ARG:
+        return _spring_elongation_bracketed(F, K_S, x_limit, fact)
     for _ in range(60):
         r = spring_force(x, K_S, x_limit, fact) - F
         k = spring_stiffness(x, K_S, x_limit, fact)
