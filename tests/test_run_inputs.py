@@ -23,6 +23,15 @@ def test_times_beyond_the_clock_are_refused_not_wrapped(value):
         ticks_array("voltage start", np.array([0.0, value]))
 
 
+@pytest.mark.parametrize("kw", [{"dt_s": 1e-300}, {"output_interval_s": 1e-300}, {"dt_s": 4e-10}])
+def test_times_below_the_clocks_tick_are_refused(kw):
+    """A positive time under half a nanosecond rounded to 0 ticks and passed: --dt 1e-300 hung the
+    kernel (0 s steps), --output-interval 1e-300 divided by zero (found by review)."""
+    name = next(iter(kw))
+    with pytest.raises(ValueError, match=rf"{name} = .* s is shorter than the clock's tick, 1 ns"):
+        make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0, **kw)
+
+
 @given(st.integers(0, MAX_TICKS))
 @settings(max_examples=300, deadline=None)
 def test_every_whole_nanosecond_in_range_is_held_without_overflow(k):

@@ -37,6 +37,8 @@ def to_ticks(name: str, value_s: float, allow_zero: bool = False) -> int:
     if value_s > MAX_S:
         raise _beyond(name, value_s)
     ticks = round(value_s / TICK_S)
+    if ticks == 0 and value_s > 0:  # 1e-300 s passed the test below as 0 ticks (a 0 s step: a hang)
+        raise ValueError(f"{name} = {value_s!r} s is shorter than the clock's tick, 1 ns")
     if abs(ticks * TICK_S - value_s) > 1e-6 * TICK_S * max(1.0, ticks) and abs(ticks * TICK_S - value_s) > 1e-12:
         raise ValueError(f"{name} = {value_s!r} s is not a whole number of nanoseconds")
     return int(ticks)
