@@ -48,7 +48,8 @@ def test_params_file_and_set(tmp_path):
     (["simulate", "--strategy", "open-loop", "--voltage", "0:8:8"], "interlock"),
     (["simulate", "--strategy", "sideways", "--profile", "0:-25"], "strategy"),
     (["simulate", "--bogus"], "--bogus"),
-    (["simulate", "--profile", "0:-25", "--dt", "1.5e-10"], "nanoseconds"),
+    (["simulate", "--profile", "0:-25", "--dt", "1.5e-9"], "nanoseconds"),
+    (["simulate", "--profile", "0:-25", "--dt", "1.5e-10"], "shorter than the clock's tick"),
     (["simulate", "--params", "nosuchset"], "nosuchset"),
     (["simulate", "--profile", "0:-25", "--out", "x.txt"], ".csv or .parquet"),
 ])
