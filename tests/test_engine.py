@@ -236,8 +236,10 @@ def test_long_pwm_voltage_program_matches_item_by_item_parse():
     assert prog.steps == tuple(items)
     starts = prog.arrays()[0]
     assert ticks_array("voltage start", starts).tolist() == [to_ticks("t", t, True) for t in starts]
-    with pytest.raises(ValueError, match=r"voltage start \[1\] = 1e-10 s is not a whole number"):
+    with pytest.raises(ValueError, match=r"voltage start \[1\] = 1e-10 s is shorter than the clock's tick"):
         ticks_array("voltage start", np.array([0.0, 1e-10]))
+    with pytest.raises(ValueError, match=r"voltage start \[1\] = 1.5e-09 s is not a whole number"):
+        ticks_array("voltage start", np.array([0.0, 1.5e-9]))
 
 
 def test_a_low_level_that_heats_both_wires_is_warned_of():

@@ -11,8 +11,9 @@ of sticking, and a static friction alone makes the stick-slip pattern, and so th
 with every small change of the other parameters; tied, the misfit is smooth in the friction near
 a small friction, but still rugged where the friction is large, see ``docs/identification.md``).
 
-Transformation temperatures come in ordered pairs (A_S0 < A_F0, M_F0 < M_S0; a set with them
-the other way round is invalid). When a pair member is free its range is narrowed to keep the
+Transformation temperatures come in ordered pairs (A_S0 < A_F0, M_F0 < M_S0, and for a major
+loop that is not empty M_F0 < A_S0, M_S0 < A_F0; a set with them the other way round is
+invalid). When a pair member is free its range is narrowed to keep the
 order by at least :data:`MIN_GAP_C`: the upper member maps onto [max(LO, lower + gap), HI], the
 lower onto [LO, min(HI, upper - gap)] when the upper is held. Every point of the box is then a
 valid, ordered set: the optimisers never meet a refusal there.
@@ -28,8 +29,11 @@ import numpy as np
 from ..parameters import ParameterError, ParameterSet
 from ..parameters.mechanisms import JointParameters, LinearActuatorParameters
 
-#: (lower, upper) fields that must stay ordered
-ORDERED_PAIRS = (("A_S0_C", "A_F0_C"), ("M_F0_C", "M_S0_C"))
+#: (lower, upper) fields that must stay ordered: each transformation's start and finish, and
+#: the major loop not empty at zero stress (M_F0 < A_S0, M_S0 < A_F0: a set is refused otherwise)
+ORDERED_PAIRS = (("A_S0_C", "A_F0_C"), ("M_F0_C", "M_S0_C"), ("M_F0_C", "A_S0_C"), ("M_S0_C", "A_F0_C"))
+#: the order the box decides the temperatures in: each after the lower members of its pairs
+_RANK = {"M_F0_C": 0, "A_S0_C": 1, "M_S0_C": 1, "A_F0_C": 2}
 #: smallest width kept between the members of an ordered pair [degC]
 MIN_GAP_C = 0.5
 
@@ -223,8 +227,7 @@ class FreeBox:
 
     def _order(self) -> list[int]:
         """Lower pair members first, so that an upper member's range is known."""
-        uppers = {u for _, u in ORDERED_PAIRS}
-        return sorted(range(self.n), key=lambda i: self.names[i] in uppers)
+        return sorted(range(self.n), key=lambda i: _RANK.get(self.names[i], 0))
 
     def values(self, u) -> dict[str, float]:
         """Field values at the point u of the unit box."""
