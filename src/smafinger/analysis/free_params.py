@@ -32,10 +32,13 @@ from ..parameters.mechanisms import JointParameters, LinearActuatorParameters
 #: (lower, upper) fields that must stay ordered: each transformation's start and finish, and
 #: the major loop not empty at zero stress (M_F0 < A_S0, M_S0 < A_F0: a set is refused otherwise)
 ORDERED_PAIRS = (("A_S0_C", "A_F0_C"), ("M_F0_C", "M_S0_C"), ("M_F0_C", "A_S0_C"), ("M_S0_C", "A_F0_C"))
-#: the order the box decides the temperatures in: each after the lower members of its pairs
-_RANK = {"M_F0_C": 0, "A_S0_C": 1, "M_S0_C": 1, "A_F0_C": 2}
 #: smallest width kept between the members of an ordered pair [degC]
 MIN_GAP_C = 0.5
+
+
+def _rank(name: str) -> int:
+    """How many ordered pairs deep ``name`` sits (0: the lower member of every pair it is in)."""
+    return max((1 + _rank(lower) for lower, upper in ORDERED_PAIRS if upper == name), default=0)
 
 
 class FreeParameterError(ParameterError):
@@ -226,8 +229,8 @@ class FreeBox:
         return lo, hi
 
     def _order(self) -> list[int]:
-        """Lower pair members first, so that an upper member's range is known."""
-        return sorted(range(self.n), key=lambda i: _RANK.get(self.names[i], 0))
+        """Each field after the lower members of its pairs, so that an upper member's range is known."""
+        return sorted(range(self.n), key=lambda i: _rank(self.names[i]))
 
     def values(self, u) -> dict[str, float]:
         """Field values at the point u of the unit box."""
