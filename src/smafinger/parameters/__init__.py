@@ -82,4 +82,5 @@ def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
 
 
 __all__ = ["ParameterError", "ParameterSet", "JointParameters", "LinearActuatorParameters", "ModelOptions",
-           "MECHANISMS", "get", "names", "changed_from_named", "resolve", "load_toml", "from_dict", "field_spec", "parse_value", "REGISTRY"]
+           "MECHANISMS", "get", "names", "changed_from_named", "resolve", "load_toml", "from_dict", "field_spec",
+           "parse_value", "REGISTRY"]
