@@ -118,12 +118,33 @@ def test_memory_rule_follows_the_algebraic_stress():
 
 @pytest.mark.xfail(strict=True, reason=(
     "the first sample of a heated wire that starts outside the major loop under the algebraic law: "
-    "the engine places xi_init = 1 at 80 degC onto the heating curve at 0.97188, the oracle at 0.97233 "
-    "(later samples agree within 1.5e-6; found while fixing the direction above, not yet traced)"))
+    "the engine places xi_init = 1 at 80 degC onto the heating curve at the stress solved with xi = 1 "
+    "(12.83 MPa: xi 0.97188), then solves the stress with the placed xi (13.15 MPa), where the point is "
+    "behind its extreme and holds; the oracle solves the placement and the stress together (13.148 MPa, "
+    "xi 0.97233, on the curve). Later samples agree within 1.5e-6: the heating passes the extreme"))
 def test_the_first_sample_outside_the_loop_matches_the_oracle():
     p = get("authors2020").replace(hysteresis="memory", T_amb_C=80.0, T_init_C=80.0)
     err, _ = trajectory_errors(p, "0:8:0,3:0:0", "voltage", 6.0)
     assert err["xi"] <= 1e-4, err
+
+
+def test_the_first_sample_outside_the_loop_is_placed_at_the_stress_before_it():
+    """The xfail above, traced (not changed): the engine places xi on the heating curve at the
+    stress solved with xi_init = 1, and the stress solved with the placed xi is higher, so the
+    point (T, sigma, xi) is inside the loop, behind its extreme, where the memory rule holds it;
+    the oracle's placement is the self-consistent one. Fixing it means re-placing from the old
+    branch at the re-solved stress inside the memory update, whose stack is written in place."""
+    from oracle.build import build
+    from oracle.material import heating_curve
+
+    p = get("authors2020").replace(hysteresis="memory", T_amb_C=80.0, T_init_C=80.0)
+    r = simulate(p, "open-loop", voltage="0:8:0,3:0:0", t_end_s=0.02, dt_s=1e-3, method="rk4",
+                 output_interval_s=0.01)
+    upper = build(p).wires[0]
+    xi0, sigma0 = r.wires["xi"][0, 0], r.wires["sigma"][0, 0]
+    assert xi0 == pytest.approx(heating_curve(80.0, upper.sigma0, upper.transformation)[0], abs=1e-9)
+    assert sigma0 > upper.sigma0 + 1e5  # solved with the placed xi: 13.15 against 12.83 MPa
+    assert xi0 < heating_curve(80.0, sigma0, upper.transformation)[0] - 1e-4  # off the curve there
 
 
 def test_the_linear_rigs_xi_follows_the_memory_rule_on_its_own_path():
