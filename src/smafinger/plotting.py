@@ -12,9 +12,7 @@ from .files import atomic_write
 
 
 def _mpl():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
+    """pyplot, on the caller's backend (the command line sets Agg for itself, ``cli.main``)."""
     import matplotlib.pyplot as plt
 
     return plt
@@ -56,7 +54,9 @@ def plot_result(result, path: str | Path | None = None, title: str | None = None
         if p.mechanism == "joint":
             ax[4].plot(t, 1e3 * result.signal(f"spring_{w}_m"), color=c, label=f"{w} spring")
     ax[2].set_ylabel("Wire temperature [°C]")
-    ax[3].set_ylabel("Drive [V]" if open_loop else r"Mean voltage $V_H\,DC\%$ [V]")
+    current = result.spec.voltage is not None and result.spec.voltage.kind == "current"
+    ax[3].set_ylabel(("Drive current [A]" if current else "Drive [V]") if open_loop
+                     else r"Mean voltage $V_H\,DC\%$ [V]")
     ax[4].set_ylabel("Deformation [mm]")
     ax[4].set_xlabel("Time [s]")
     for a in ax[2:]:

@@ -16,6 +16,21 @@ from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older im
 from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
 
+def _read_only(a: np.ndarray) -> np.ndarray:
+    """A view of ``a`` that cannot be written through."""
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
+def _suffixed(path: str | Path, suffix: str, method: str) -> str | Path:
+    """``path``, refused (ValueError naming it) unless it ends in ``suffix``."""
+    if Path(path).suffix.lower() != suffix:
+        raise ValueError(f"{method}: path {str(path)!r} does not end in {suffix} "
+                         f"(save() writes CSV, Parquet or MATLAB by the suffix)")
+    return path
+
+
 @dataclass
 class SimulationResult:
     """A run's signals (sampled at the output interval), metrics and run statistics.
@@ -61,6 +76,7 @@ class SimulationResult:
 
     @property
     def column_names(self) -> list[str]:
+        """The exported columns' names (``t_s``, ``theta_deg``, ``T_upper_C``, ...), in order."""
         return [c[0] for c in self.columns]
 
     @property
@@ -75,16 +91,18 @@ class SimulationResult:
 
     @property
     def t(self) -> np.ndarray:
-        return self.mechanism_signals[MC.t]
+        """The sample times [s] (a read-only view)."""
+        return _read_only(self.mechanism_signals[MC.t])
 
     def signal(self, name: str) -> np.ndarray:
-        """An exported signal by its column name (e.g. ``theta_deg``, ``T_upper_C``): a view of
-        the recorded row if it is exported as recorded, else a scaled copy."""
+        """An exported signal by its column name (e.g. ``theta_deg``, ``T_upper_C``): a read-only
+        view of the recorded row if it is exported as recorded (``T = r.T_upper_C; T += 273.15``
+        would otherwise change the result, its metrics and what it saves), else a scaled copy."""
         for col, fld, where, scale in self.columns:
             if col == name:
                 raw = (self.mechanism_signals[getattr(MC, fld)] if where == "mechanism"
                        else self.wire_signals[where, getattr(WC, fld)])
-                return raw if scale == 1.0 else raw * scale
+                return _read_only(raw) if scale == 1.0 else raw * scale
         also = "; this run recorded only its metrics' signals" if self.recorded is not None else ""
         raise KeyError(f"no signal {name!r} (signals: {', '.join(self.column_names)}{also})")
 
@@ -105,21 +123,26 @@ class SimulationResult:
                                    samples_every=self.samples_every * every, _metrics=metrics)
 
     def to_pandas(self):
+        """The exported signals as a :class:`pandas.DataFrame`, one column per :attr:`column_names`
+        (the CSV's columns, in its units), one row per sample; a copy."""
         import pandas as pd
 
-        return pd.DataFrame({name: self.signal(name) for name in self.column_names})
+        return pd.DataFrame({name: np.array(self.signal(name)) for name in self.column_names})
 
     def to_csv(self, path: str | Path) -> None:
-        """The signals as CSV, with the provenance in ``NAME.provenance.json`` beside it."""
-        self.save(path)
+        """The signals as CSV, with the provenance in ``NAME.provenance.json`` beside it.
+        ``path`` must end in ``.csv`` (:meth:`save` chooses the format by the suffix)."""
+        self.save(_suffixed(path, ".csv", "to_csv"))
 
     def to_parquet(self, path: str | Path) -> None:
-        """The signals as Parquet, with the provenance in the schema metadata."""
-        self.save(path)
+        """The signals as Parquet, with the provenance in the schema metadata.
+        ``path`` must end in ``.parquet``."""
+        self.save(_suffixed(path, ".parquet", "to_parquet"))
 
     def to_mat(self, path: str | Path) -> None:
-        """The signals as a MATLAB file (one Structure With Time per signal, and provenance)."""
-        self.save(path)
+        """The signals as a MATLAB file (one Structure With Time per signal, and provenance).
+        ``path`` must end in ``.mat``."""
+        self.save(_suffixed(path, ".mat", "to_mat"))
 
     def save(self, path: str | Path) -> None:
         """CSV, Parquet or MATLAB by the file's suffix (:mod:`smafinger.export`), atomically."""
@@ -162,6 +185,12 @@ class SimulationResult:
         out.commit()
 
     def plot(self, path: str | Path | None = None, title: str | None = None):
+        """Five stacked panels laid out like the paper's figures (:func:`.plotting.plot_result`).
+
+        Returns the :class:`matplotlib.figure.Figure`; with ``path`` it is also written there
+        (PNG, PDF or SVG by the suffix, atomically) and closed. Uses matplotlib's current
+        backend (without a display, matplotlib picks Agg itself).
+        """
         from .plotting import plot_result
 
         return plot_result(self, path, title)

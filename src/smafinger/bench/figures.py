@@ -62,10 +62,7 @@ def _axes_label(rec) -> str:
 def task_figure(records: dict, task: Task):
     """(name, PNG bytes) of one task, from its runs' records ((mechanism, task, controller,
     strategy) -> RunRecord; others are ignored)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # on the caller's backend (the command line's: Agg, cli.main)
 
     keys = [k for k in records if k[0] == task.mechanism and k[1] == task.name]
     strategies = list(dict.fromkeys(k[3] for k in keys))
@@ -102,10 +99,7 @@ def task_figure(records: dict, task: Task):
 def bandwidth_figure(rows: pd.DataFrame, mechanism: str, tasks: Sequence[Task]):
     """(name, PNG bytes): the fitted gain of every sine task against its frequency (log-log), from
     the bench's rows (:attr:`~.runner.BenchResult.rows`)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # on the caller's backend (the command line's: Agg, cli.main)
 
     freq = {t.name: t.frequency_hz for t in tasks if t.mechanism == mechanism and t.kind == "sine"}
     rows = rows[(rows["mechanism"] == mechanism) & (rows["task"].isin(list(freq)))]

@@ -10,6 +10,7 @@ the console script ``smafinger`` and ``python -m smafinger.cli`` call it.
 from __future__ import annotations
 
 import gc
+import os
 import sys
 
 import typer
@@ -42,7 +43,11 @@ app.command("tune")(command(interrupted=NOTHING_WRITTEN)(tune))
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line ``argv`` (default: ``sys.argv[1:]``); returns the exit status."""
+    """Run the command line ``argv`` (default: ``sys.argv[1:]``); returns the exit status.
+
+    The commands write their figures to files: matplotlib gets the Agg backend unless
+    ``MPLBACKEND`` says otherwise (the library itself leaves the caller's backend alone)."""
+    os.environ.setdefault("MPLBACKEND", "Agg")
     return run_app(app, argv)
 
 

@@ -22,10 +22,7 @@ SETTLED_DEG = 0.05
 
 
 def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # on the caller's backend (the command line's: Agg, cli.main)
 
     plt.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "legend.fontsize": 8,
                          "axes.grid": True, "grid.alpha": 0.3})
