@@ -52,6 +52,10 @@ def here(tmp_path, monkeypatch):
     (["simulate", *QUICK, "--out", "s.csv", "--summary", "s.provenance.json"], "the same file is given for two"),
     (["params", "paper2010", "--out", "d"], "--out d: is a folder; give a file name"),
     (["params", ""], "parameter set '': give a named set"),
+    (["params", "--out", "p.toml"], "--out needs a set"),  # found by review: exit 0, nothing written
+    (["params", "--set", "V_H_V=abc"], "--set needs a set"),
+    (["params", "paper2010", "--out", "p.csv"], "--out p.csv: the file name must end in .toml"),
+    (["params", "paper2010", "--set", "name=\udcff", "--out", "p.toml"], "name: '\\udcff' is not valid text"),
     (["reproduce", "--out", "f", "--only", "fig8-h0-60-upper-v1"], "--out f: is a file; give a folder"),
     (["reproduce", "--out", "o", "--only", "fig99-v1"], "unknown scenario 'fig99-v1'"),
     (["simulate", "--t-end", "1e308", "--profile", "0:-25"], "t_end_s = 1e+308 s is beyond the clock's range"),

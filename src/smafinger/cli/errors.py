@@ -10,6 +10,8 @@ exit status   meaning
               and the value (data whose fit is no valid parameter set too); nothing is written
 3             ``sweep``: runs failed (every run, or any with ``--strict``)
 130           interrupted (Ctrl-C; SIGTERM for sweeps): one line saying what was kept
+141           the standard output was closed by its reader (``smafinger params | head -1``):
+              nothing more is printed, as a tool killed by SIGPIPE would end
 ============  ===========================================================================
 
 Every command is wrapped by :func:`command`, so it behaves the same whether it runs under
@@ -30,6 +32,7 @@ import typer
 from typer.exceptions import TyperException
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_RUNS_FAILED, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_BROKEN_PIPE = 141  #: 128 + SIGPIPE: what a shell reports for a tool that signal ended
 #: the interruption note of commands that write their outputs only at the end
 NOTHING_WRITTEN = "no output was written"
 
@@ -80,15 +83,25 @@ def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
         return EXIT_FAILED, f"smafinger: failed: {first_line(exc)}"
     if isinstance(exc, MemoryError):
         return EXIT_FAILED, "smafinger: out of memory: the run or its outputs do not fit; record less often or less time"
+    if isinstance(exc, BrokenPipeError) and exc.filename is None:  # the reader of stdout went away
+        return EXIT_BROKEN_PIPE, ""
     if isinstance(exc, OSError):
-        where = f" {exc.filename}" if exc.filename else ""
-        return EXIT_FAILED, f"smafinger: error:{where}: {exc.strerror or first_line(exc)}"
+        where = f"{exc.filename}: " if exc.filename else ""
+        return EXIT_FAILED, f"smafinger: error: {where}{exc.strerror or first_line(exc)}"
     return EXIT_FAILED, (f"smafinger: internal error: {type(exc).__name__}: {first_line(exc)} "
                          "(please report it; SMAFINGER_DEBUG=1 shows where)")
 
 
 def _report(line: str) -> None:
-    """Print the one line (after the traceback of an internal error, with SMAFINGER_DEBUG=1)."""
+    """Print the one line (after the traceback of an internal error, with SMAFINGER_DEBUG=1);
+    no line (a closed standard output): point stdout at the null device, so that the flush at
+    the process's end does not fail on the closed pipe again."""
+    if not line:
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):  # stdout is no file descriptor (captured)
+            pass
+        return
     if line.startswith("smafinger: internal error") and os.environ.get("SMAFINGER_DEBUG"):
         traceback.print_exc()
     print(line, file=sys.stderr)

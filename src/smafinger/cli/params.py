@@ -18,9 +18,14 @@ def params(
     out: Optional[Path] = typer.Option(None, "--out", metavar="FILE.toml", help="write the set to FILE.toml"),
 ):
     """List the named parameter sets, or print/save one as TOML."""
+    from ..export import check_suffix
     from ..files import Outputs, check_output
     from ..parameters import names, resolve
+    from .errors import UsageError
 
+    if name is None and (out is not None or set_):
+        given = "--out" if out is not None else "--set"
+        raise UsageError(f"{given} needs a set: smafinger params NAME|FILE.toml {given} ...")
     if name is None:
         for n in names():
             p = resolve(n)
@@ -28,6 +33,7 @@ def params(
         return
     if out is not None:
         check_output(out, "--out")  # a bad path is refused before anything is loaded
+        check_suffix(out, (".toml",), "--out")
     text = load_params(name, set_, "parameter set").to_toml()
     if out is None:
         typer.echo(text, nl=False)
