@@ -2,6 +2,7 @@
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -64,6 +65,52 @@ def test_an_upper_spring_length_the_equilibrium_start_ignores_is_refused():
     assert p.replace(spring_length_upper_m=p.spring_length_upper_m) == p  # unchanged: accepted
     with pytest.raises(ParameterError, match="has no effect"):  # the same through --set
         given.with_overrides(["spring_init=equilibrium", "spring_length_upper_m=0.0175"])
+
+
+def test_the_ignored_spring_length_edited_in_a_named_sets_file_is_refused(tmp_path):
+    """Found by review: the file `params paper2010 --out` writes, with spring_length_upper_m
+    edited, ran unchanged while the summary named the field changed."""
+    p = get("paper2010")
+    f = tmp_path / "p.toml"
+    p.save(f)
+    assert load_toml(f, get) == p  # unedited: accepted
+    f.write_text(f.read_text().replace(f"spring_length_upper_m = {p.spring_length_upper_m!r}",
+                                       "spring_length_upper_m = 0.02"))
+    with pytest.raises(ParameterError, match="spring_length_upper_m = 0.02 has no effect"):
+        load_toml(f, get)
+    f.write_text(f.read_text().replace('name = "paper2010"', 'name = "mine"'))
+    assert load_toml(f, get).spring_length_upper_m == 0.02  # a set of the user's own: no reference
+
+
+@pytest.mark.parametrize("value", [np.float32(6.0), np.int64(6), np.float64(6.0), 6])
+def test_numpy_and_whole_numbers_are_stored_as_floats(value):
+    """Found by review: numpy scalars were refused as 'not a number'."""
+    v = get("paper2010").replace(V_H_V=value).V_H_V
+    assert type(v) is float and v == 6.0
+
+
+@pytest.mark.parametrize("value, needle", [
+    (10 ** 400, "V_H_V = 1000000000"),  # was an internal OverflowError
+    (np.True_, "is not a number"),
+    (True, "is not a number"),
+    ("6", "is not a number"),
+])
+def test_values_that_are_no_numbers_are_refused_naming_the_field(value, needle):
+    with pytest.raises(ParameterError, match=needle):
+        get("paper2010").replace(V_H_V=value)
+
+
+@pytest.mark.parametrize("text, needle", [
+    ('base = ["paper2010"]\n', "base = \\['paper2010'\\] is not a string"),
+    ('mechanism = ["joint"]\n', "mechanism = \\['joint'\\] is not a string"),
+    ('base = "paper2010.toml"\n', "base = 'paper2010.toml': unknown parameter set 'paper2010.toml' \\(known: "),
+])
+def test_a_files_base_and_mechanism_are_names(tmp_path, text, needle):
+    f = tmp_path / "p.toml"
+    f.write_text(text)
+    with pytest.raises(ParameterError, match=needle) as info:
+        load_toml(f, get)
+    assert ".toml file" not in str(info.value)  # base takes no file
 
 
 def test_a_set_changed_under_its_name_lists_what_changed():

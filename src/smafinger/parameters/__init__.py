@@ -34,12 +34,9 @@ def names() -> list[str]:
 
 def get(name: str) -> ParameterSet:
     """A named parameter set."""
-    try:
-        return REGISTRY[name]()
-    except KeyError:
-        raise ParameterError(
-            f"unknown parameter set {name!r} (known: {', '.join(names())}, or a .toml file)"
-        ) from None
+    if not isinstance(name, str) or name not in REGISTRY:
+        raise ParameterError(f"unknown parameter set {name!r} (known: {', '.join(names())})")
+    return REGISTRY[name]()
 
 
 def changed_from_named(p: ParameterSet) -> tuple[str, ...]:
@@ -78,7 +75,7 @@ def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
         return get(s)
     if s.endswith(".toml") or Path(s).exists():
         return load_toml(s)
-    return get(s)
+    raise ParameterError(f"unknown parameter set {s!r} (known: {', '.join(names())}, or a .toml file)")
 
 
 __all__ = ["ParameterError", "ParameterSet", "JointParameters", "LinearActuatorParameters", "ModelOptions",

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
@@ -119,10 +120,11 @@ class ParameterSet:
             raise ParameterError(f"options: {self.options!r} is not a ModelOptions")
         for f in fields(self):
             if f.name != "options":
-                _check_field(f, getattr(self, f.name))
-                if f.metadata["kind"] == "float" and not isinstance(getattr(self, f.name), float):
-                    # a whole number (V_H_V = 6 in a file): stored as float, as the compiled records expect
-                    object.__setattr__(self, f.name, float(getattr(self, f.name)))
+                value = _checked_field(f, getattr(self, f.name))
+                if value is not getattr(self, f.name):
+                    # a whole number (V_H_V = 6 in a file) or a numpy scalar: stored as float, as the
+                    # compiled records expect
+                    object.__setattr__(self, f.name, value)
         self._cross_checks()
 
     def __getattr__(self, name: str) -> Any:
@@ -228,14 +230,26 @@ def parse_value(name: str, raw: str, cls: type | None = None) -> Any:
     return raw.strip('"').strip("'")
 
 
-def _check_field(f: dataclasses.Field, v: Any) -> None:
+def _checked_field(f: dataclasses.Field, v: Any) -> Any:
+    """``v`` checked against the field's kind and range: a number as a Python float (an int, a
+    numpy scalar), other kinds as given; :class:`ParameterError` naming the field and the value."""
     kind = f.metadata["kind"]
     if kind == "float":
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
+        if isinstance(v, bool) or not isinstance(v, numbers.Real):  # numpy's bool is no numbers.Real
             raise ParameterError(f"{f.name}: {v!r} is not a number")
         lo, hi = f.metadata["range"]
-        if not math.isfinite(v) or not (lo <= v <= hi):
+        try:
+            x = float(v)
+        except OverflowError:  # an int beyond any float
+            raise ParameterError(f"{f.name} = {v!r:.40} is outside the allowed range [{lo:g}, {hi:g}]") from None
+        if not math.isfinite(x) or not (lo <= x <= hi):
             raise ParameterError(f"{f.name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
-    elif kind == "str":
+        return v if type(v) is float else x
+    if kind == "str":
         if not isinstance(v, str):
             raise ParameterError(f"{f.name}: {v!r} is not a string")
+        try:
+            v.encode("utf-8")
+        except UnicodeEncodeError:  # a byte of another encoding on the command line (a surrogate)
+            raise ParameterError(f"{f.name}: {v!r} is not valid text (UTF-8)") from None
+    return v

@@ -93,8 +93,14 @@ def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> Param
     if unknown_opt:
         raise ParameterError(f"unknown option(s) in [options]: {', '.join(unknown_opt)}")
     label = data.pop("mechanism", None)
+    for key, value in (("base", base_name), ("mechanism", label)):
+        if value is not None and not isinstance(value, str):
+            raise ParameterError(f"{key} = {value!r} is not a string")
     if base_name is not None:
-        base = registry_get(base_name)
+        try:
+            base = registry_get(base_name)
+        except ParameterError as exc:
+            raise ParameterError(f"base = {base_name!r}: {exc}") from None
         if label is not None and label != base.mechanism:
             raise ParameterError(f"mechanism = {label!r} but base {base_name!r} is a {base.mechanism} set")
         return base.replace(**data, **options)
@@ -114,7 +120,14 @@ def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> Param
         raise ParameterError(f"missing option(s) {', '.join(missing_opt)} (or give base = \"NAME\" of a named set)")
     data.setdefault("name", "custom")
     data.setdefault("source", "user parameter file")
-    return cls(**data, options=ModelOptions(**options))
+    p = cls(**data, options=ModelOptions(**options))
+    try:
+        named = registry_get(p.name)
+    except ParameterError:  # a set of the user's own
+        return p
+    if type(named) is cls and hasattr(p, "refuse_ignored_changes"):  # a named set's file, edited
+        p.refuse_ignored_changes(named)
+    return p
 
 
 def _required(cls: type, name: str) -> bool:

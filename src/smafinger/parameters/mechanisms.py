@@ -60,7 +60,8 @@ class JointParameters(ParameterSet):
     # --- spring-slack tendons --------------------------------------------------------------
     spring_K_N_m: float = _num(1e-3, 1e6, "bias spring stiffness K_S")
     spring_free_length_m: float = _num(0.0, 1.0, "spring unstretched length")
-    spring_length_upper_m: float = _num(0.0, 1.0, "initial upper spring length")
+    spring_length_upper_m: float = _num(0.0, 1.0, "initial upper spring length (used with spring_init = "
+                                        "given; equilibrium solves it from theta0_deg)")
     spring_length_lower_m: float = _num(0.0, 1.0, "initial lower spring length")
     slack_m: float = _num(0.0, 1.0, "spring elongation beyond initial at which slack is taken up")
     slack_band_m: float = _num(0.0, 1.0, "stiffening starts this far before the slack point")
@@ -84,13 +85,20 @@ class JointParameters(ParameterSet):
         """A copy with some parameters or options changed (validated); a new
         ``spring_length_upper_m`` is refused where ``spring_init = equilibrium`` ignores it."""
         new = super().replace(**changes)
-        if ("spring_length_upper_m" in changes and new.spring_init == SpringInit.EQUILIBRIUM
-                and new.spring_length_upper_m != self.spring_length_upper_m):
-            raise ParameterError(
-                f"spring_length_upper_m = {new.spring_length_upper_m} has no effect with spring_init = "
-                f"equilibrium (the upper spring is solved from the moment balance at theta0_deg); "
-                f"set spring_init=given with it")
+        if "spring_length_upper_m" in changes:
+            new.refuse_ignored_changes(self)
         return new
+
+    def refuse_ignored_changes(self, before: "JointParameters") -> None:
+        """:class:`ParameterError` if this set differs from ``before`` in a value its options
+        ignore: ``spring_length_upper_m`` under ``spring_init = equilibrium`` (a change there would
+        run unchanged while the summary names it changed)."""
+        if (self.spring_init == SpringInit.EQUILIBRIUM
+                and self.spring_length_upper_m != before.spring_length_upper_m):
+            raise ParameterError(
+                f"spring_length_upper_m = {self.spring_length_upper_m} has no effect with spring_init = "
+                f"equilibrium (the upper spring is solved from the moment balance at theta0_deg; "
+                f"{before.name} has {before.spring_length_upper_m}); set spring_init=given with it")
 
     def _cross_checks(self) -> None:
         super()._cross_checks()
