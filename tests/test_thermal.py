@@ -51,6 +51,26 @@ def test_two_node_steady_state():
     assert np.all(single.T_casing_upper_C == p.T_amb_C)
 
 
+def test_two_node_steady_state_with_radiation():
+    """Every watt the wire gives off reaches the casing: T_case = T_amb + P'/G with radiation too.
+    Found by review: the wire radiated to the casing's temperature but the casing never received
+    it (T_case 26.10 degC against 26.72, 17 % of the power lost at emissivity 0.8)."""
+    from scipy.optimize import brentq
+
+    h, G, C, eps, sigma_sb, K = 30.0, 0.5, 2.0, 0.8, 5.670374419e-8, 273.15
+    p = get("paper2010").replace(thermal_model="two-node", h0_heating_W_m2K=h, h2_heating_W_m2K3=0.0,
+                                 h0_cooling_W_m2K=h, h2_cooling_W_m2K3=0.0, casing_loss_W_mK=G,
+                                 casing_heat_capacity_J_mK=C, emissivity=eps)
+    _, _, A_w = wire_constants(p)
+    V = 4.0
+    P = V**2 / p.resistance_ohm_per_m
+    r = simulate(p, "open-loop", voltage=f"0:{V}:0", t_end_s=200.0, output_interval_s=0.1)
+    T_case = p.T_amb_C + P / G
+    loss = lambda T: h * A_w * (T - T_case) + eps * sigma_sb * A_w * ((T + K) ** 4 - (T_case + K) ** 4) - P
+    assert r.T_casing_upper_C[-1] == pytest.approx(T_case, rel=1e-6)
+    assert r.T_upper_C[-1] == pytest.approx(brentq(loss, T_case, T_case + P / (h * A_w)), rel=1e-6)
+
+
 def test_latent_heat_balance_through_a_transformation():
     """Adiabatic wire at constant power: P' t = M_w C_p (T - T0) + M_w dH (xi0 - xi), per metre."""
     dH = 24e3

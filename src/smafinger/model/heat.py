@@ -96,16 +96,18 @@ def radiation_per_m(wire, T, T_sur):
 
 @njit(cache=True, forceinline=True)
 def casing_temperature_rate(wire, T, T_case, heating, opts):
-    """dT_case/dt of the two-node model: C_case dT_case/dt = h A_w (T - T_case) - G (T_case - T_amb).
+    """dT_case/dt of the two-node model:
+    C_case dT_case/dt = h A_w (T - T_case) + eps sigma_SB A_w (T_K^4 - T_case,K^4) - G (T_case - T_amb).
 
     Per metre of wire: C_case = ``casing_heat_capacity_J_mK``, G = ``casing_loss_W_mK``; the wire
-    side is Eq. (11)'s convection term, now to the casing air (Sec. 3.2: "heat transfer between
-    SMA wire and the inside air of the actuator, and ... the inside air and the open air").
-    0 in the single-node model.
+    side is what the wire loses in :func:`wire_temperature_rate`, Eq. (11)'s convection term and
+    the radiation, both now to the casing (Sec. 3.2: "heat transfer between SMA wire and the
+    inside air of the actuator, and ... the inside air and the open air"), so that every joule
+    the wire gives off reaches the casing. 0 in the single-node model.
     """
     if opts.thermal_model != ThermalModel.TWO_NODE:
         return 0.0
-    q_in = wire_h(wire, T, heating) * wire.perimeter_m * (T - T_case)
+    q_in = wire_h(wire, T, heating) * wire.perimeter_m * (T - T_case) + radiation_per_m(wire, T, T_case)
     q_out = wire.casing_loss_W_mK * (T_case - wire.T_amb_C)
     return (q_in - q_out) / wire.casing_heat_capacity_J_mK
 
