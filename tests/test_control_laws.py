@@ -27,3 +27,49 @@ def test_sliding_mode_anti_windup_freezes_the_integral_at_its_own_gain(K_pct):
     assert np.max(np.abs(free.duty_upper - clamped.duty_upper)) > 1.0
     assert np.max(np.abs(free.theta_deg - clamped.theta_deg)) > 0.1
     assert np.max(free.duty_upper) == pytest.approx(K_pct) and np.max(clamped.duty_upper) == pytest.approx(K_pct)
+
+
+def test_a_controller_that_reads_an_undeclared_sensor_stops_the_run_at_once():
+    """Its NaN duty left the wire off to the end without a word (found by review; the sensing
+    module's docstring promised the stop). Rapid heating reading the angle it did not declare:"""
+    from dataclasses import dataclass
+    from typing import ClassVar
+
+    from smafinger.control.params import RapidHeatingParameters
+    from smafinger.control.sensing import Sensors
+    from smafinger.engine.run import DutyNotANumber
+
+    @dataclass(frozen=True, kw_only=True)
+    class Blind(RapidHeatingParameters):
+        sensors: ClassVar[Sensors] = Sensors(position=False, temperature=True)
+
+    with pytest.raises(DutyNotANumber, match=r"not a number at t = 0 s \(controller 'rapid-heating'"):
+        simulate("paper2010", "independent", "0:-25", t_end_s=1.0, controller=Blind())
+    assert simulate("paper2010", "independent", "0:-25", t_end_s=1.0,
+                    controller=RapidHeatingParameters()).metrics  # seeing, it runs
+
+
+@pytest.mark.parametrize("change, needle", [
+    (dict(R_ref_ohm=(0.0, 3.7)), "R_ref_ohm = \\(0.0, 3.7\\) must be above 0"),
+    (dict(R_ref_ohm=(-3.7, 3.7)), "must be above 0"),
+    (dict(c0=float("nan")), "c0 = nan holds nan, not a finite number"),
+    (dict(c1=(-3.0,)), "c1 = \\(-3.0,\\) needs one value per wire \\(2\\)"),
+    (dict(wires=("upper",)), "needs one value per wire \\(1\\)"),
+])
+def test_a_resistance_calibration_that_cannot_estimate_is_refused(change, needle):
+    """Found by review: R_ref 0 or a NaN coefficient ran with a NaN duty, a short tuple was an IndexError."""
+    import dataclasses
+
+    from smafinger.control.calibration import ResistanceCalibration
+    from smafinger.control.params import ResistanceFeedbackParameters
+    from smafinger.parameters import ParameterError
+
+    good = dict(wires=("upper", "lower"), R_ref_ohm=(3.7, 3.7), c0=-0.7, c1=(1.0, -1.0), c2=(0.0, 0.0),
+                c3=(0.0, 0.0), rms_error=0.001, max_error=0.004)
+    ResistanceCalibration(**good)
+    with pytest.raises(ParameterError, match=needle):
+        ResistanceCalibration(**{**good, **change})
+    with pytest.raises(ParameterError, match=needle):  # as a run definition read back gives it
+        ResistanceFeedbackParameters(calibration={**good, **{k: list(v) if isinstance(v, tuple) else v
+                                                             for k, v in change.items()}})
+    assert dataclasses.asdict(ResistanceCalibration(**good))["c0"] == -0.7

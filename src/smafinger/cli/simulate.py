@@ -77,7 +77,7 @@ def simulate(
 ):
     """Simulate an SMA actuator (the finger joint or a linear bias-spring rig) and report the metrics."""
     from ..engine.interpreted import engine_setting
-    from ..engine.run import SimulationError, run_spec
+    from ..engine.run import DutyNotANumber, SimulationError, run_spec
     from ..export import add_plot, add_signals, add_summary
     from ..files import Outputs
     from ..plausibility import blowup_hint
@@ -92,6 +92,8 @@ def simulate(
     with progress_display(progress) as display:
         try:
             result = run_spec(spec, progress=display, engine=setting)
+        except DutyNotANumber:  # the step is not what to change
+            raise
         except SimulationError as exc:
             raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
     outputs = Outputs()

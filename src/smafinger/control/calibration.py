@@ -49,6 +49,28 @@ class ResistanceCalibration:
     rms_error: float  #: on the calibration run [q]
     max_error: float  #: [q]
 
+    def __post_init__(self) -> None:
+        """Refuse (ParameterError naming the field and the value) a map that would estimate NaN
+        or nonsense at every tick: found by review, R_ref 0 or a NaN coefficient ran to the end
+        with a NaN duty, the wire never heated, and a short coefficient tuple was an IndexError."""
+        n = len(self.wires) if isinstance(self.wires, tuple) else -1
+        if n < 1 or not all(isinstance(w, str) for w in self.wires):
+            raise ParameterError(f"calibration: wires = {self.wires!r} is not a tuple of wire names")
+        for name in ("R_ref_ohm", "c1", "c2", "c3"):
+            v = getattr(self, name)
+            if not isinstance(v, tuple) or len(v) != n:
+                raise ParameterError(f"calibration: {name} = {v!r} needs one value per wire ({n})")
+        for name in ("R_ref_ohm", "c0", "c1", "c2", "c3", "rms_error", "max_error"):
+            v = getattr(self, name)
+            for x in v if isinstance(v, tuple) else (v,):
+                if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+                    raise ParameterError(f"calibration: {name} = {v!r} holds {x!r}, not a finite number")
+        if not all(R > 0.0 for R in self.R_ref_ohm):
+            raise ParameterError(f"calibration: R_ref_ohm = {self.R_ref_ohm!r} must be above 0 ohm")
+        if self.rms_error < 0.0 or self.max_error < 0.0:
+            raise ParameterError(f"calibration: rms_error = {self.rms_error!r}, max_error = {self.max_error!r} "
+                                 "must be at least 0")
+
     def estimate(self, R_ohm: np.ndarray) -> np.ndarray:
         """q_hat for resistances ``R_ohm`` (samples x wires)."""
         R = np.atleast_2d(np.asarray(R_ohm, dtype=float))

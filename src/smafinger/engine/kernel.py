@@ -13,6 +13,7 @@ branches, stick/slip; the interlock is checked (two opposing wires driven at onc
 violation). The loop itself only sequences these.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -31,8 +32,8 @@ from .rhs import geometry, geometry_at
 from .schedule import Schedule, advance, confirm_tick, track_reach
 from .signals import record_sample
 from .integrators import NO_DAMPING, Method
-from .substep import (STACK_CAPACITY, Counters, authors_calls_inputs, decide, initial_commands, initial_inputs,
-                      initial_state, integrate)
+from .substep import (STACK_CAPACITY, STATUS_BAD_DUTY, Counters, authors_calls_inputs, decide, initial_commands,
+                      initial_inputs, initial_state, integrate)
 from .tuples import filled, with_field
 from .unmanaged import unmanaged
 
@@ -175,6 +176,15 @@ def _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl, 
 
 
 @njit(cache=True, forceinline=True)
+def _duties_finite(cmds):
+    """Every commanded duty is a number (a NaN duty would leave its wire off without a word)."""
+    ok = True
+    for c in cmds:
+        ok = ok and math.isfinite(c.duty)
+    return ok
+
+
+@njit(cache=True, forceinline=True)
 def _step_event(s, run, t, next_event, locate):
     """The next event a step must end at: the scheduled one or, with long steps (``locate``), the
     tick at which the target will count as reached if that comes first."""
@@ -232,6 +242,8 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         else:
             cmds, integrating, ctl = _control(model, run, t, s, y, inputs, geom, geom_q, cmds, integrating, ctl,
                                               memory, started)
+            if not _duties_finite(cmds):
+                return with_field(counters, "status", STATUS_BAD_DUTY), y, t * run.tick_s
         if run.pwm == PwmModel.SAMPLED:  # their Derivative block's update, after its output
             memory = DerivativeMemory(s.q_target - y.q, t)
         viscous = viscous_coefficient(model.dynamics, cmds, model.options.damping_switch)

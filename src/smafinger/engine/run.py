@@ -25,11 +25,16 @@ from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG,  # noqa: F401
                        DEFAULT_TOL_M, ENGINES)
+from .substep import STATUS_BAD_DUTY, STATUS_OK
 from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, WIRE_FIELDS, check_recorded, every_signal, new_outputs
 
 
 class SimulationError(RuntimeError):
     """The run diverged (NaN or Inf); the message holds the time and the state."""
+
+
+class DutyNotANumber(SimulationError):
+    """The closed-loop controller commanded a duty that is not a number (the run stops there)."""
 
 
 @dataclass(frozen=True)
@@ -270,7 +275,11 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
     else:
         counters, state, t_fail = kernel(*call_args)
     wall = time.perf_counter() - t0
-    if counters.status != 0:
+    if counters.status == STATUS_BAD_DUTY:
+        raise DutyNotANumber(f"the controller commanded a duty that is not a number at t = {t_fail:.9g} s "
+                              f"(controller {spec.controller.label if spec.controller else 'pid'!r}; does it "
+                              f"read a sensor it does not declare?): {describe_state(spec.params, state)}")
+    if counters.status != STATUS_OK:
         raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
     check_recorded(mech)
     return SimulationResult(

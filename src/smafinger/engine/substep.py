@@ -26,8 +26,14 @@ from .rhs import derivative_redone, geometry_at
 from .tuples import filled, set_item, with_field
 
 
+#: ``Counters.status``: the run went on to its end; the state became NaN or Inf (a blow-up);
+#: the controller commanded a duty that is no number (it read a sensor it did not declare, or
+#: its own arithmetic failed: the wire would silently stay off)
+STATUS_OK, STATUS_BLOWUP, STATUS_BAD_DUTY = 0, 1, 2
+
+
 class Counters(NamedTuple):
-    status: int  #: 0 ok, 1 blow-up (NaN or Inf)
+    status: int  #: STATUS_OK, STATUS_BLOWUP or STATUS_BAD_DUTY
     substeps: int
     violations: int  #: sub-steps with two opposing wires driven (the interlock)
     evals: int  #: right-hand-side evaluations
@@ -292,5 +298,5 @@ def integrate(model, run, y, inputs, geom, k1, aux, a, b, stuck, counters, cmds,
         counters = with_field(with_field(counters, "evals", counters.evals + n), "substeps", counters.substeps + 1)
     y = _after_step(model, y, stuck)
     if not _finite(y):
-        return y, with_field(counters, "status", 1), b * run.tick_s, inputs, damp
+        return y, with_field(counters, "status", STATUS_BLOWUP), b * run.tick_s, inputs, damp
     return y, counters, 0.0, inputs, damp
