@@ -211,7 +211,7 @@ def test_a_worker_of_another_version_is_refused_by_its_tasks(cluster):
         assert list(pool.map_tasks(abs, [-3])) == [3]
         pool._version = "0.0.0-not-this-one"  # as if every worker had joined with another version
         with pytest.raises(batch.BatchError, match=r"a Dask worker runs smafinger \S+, the client 0.0.0-not-this-one: "
-                                                   "install the same version on every worker; finished runs are kept"):
+                                                   "install the same version on every worker"):
             list(pool.map_tasks(abs, [-3]))
     finally:
         pool.close()

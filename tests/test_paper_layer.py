@@ -316,3 +316,24 @@ def test_a_move_is_over_when_reached_and_cooled_not_when_cooled_alone():
     assert out["cooled_s"] == 0.0 and out["reached_s"] > 1.0 and out["reached_cooled_s"] == out["reached_s"]
     assert back["cooled_s"] > 0.0 and back["reached_cooled_s"] == max(back["reached_s"], back["cooled_s"])
     assert "cooled_s" not in dict(MOVE_ENDS) and "reached_cooled_s" in dict(MOVE_ENDS)
+
+
+def test_a_claim_whose_run_failed_is_not_reported_as_not_selected():
+    """Found by review: a selected run that failed made its claims 'not run (their scenarios were
+    not selected)' in the report and on the terminal."""
+    from types import SimpleNamespace
+
+    from smafinger.paper import scenarios as scn
+    from smafinger.paper.claim import Verdict
+    from smafinger.paper.report import claims_table
+
+    claim = next(c for c in scn.claims() if c.scenarios)
+    failed = {n: SimpleNamespace(ok=False, scenario=object()) for n in claim.scenarios[:1]}
+    o = claim.evaluate(failed)
+    assert o.verdict is Verdict.NOT_RUN and o.runs_failed == claim.scenarios[:1]
+    unselected = claim.evaluate({})
+    assert unselected.verdict is Verdict.NOT_RUN and unselected.runs_failed == ()
+    text = "\n".join(claims_table([o, unselected]))
+    assert f"1 claim(s) not evaluated because a run failed: {claim.figure}" in text
+    assert f"({claim.scenarios[0]} failed)" in text
+    assert "1 claim(s) not run (their scenarios were not selected)" in text

@@ -93,3 +93,56 @@ def test_simulate_runs_a_named_scenario(tmp_path, capsys):
     assert main(["simulate", "--scenario", "fig12-extension-v1", "--out", str(csv_path), "--no-progress"]) == 0
     assert csv_path.exists()
     assert "interlock violations 0" in capsys.readouterr().out
+
+
+def test_a_second_reproduce_replaces_the_first_whole(tmp_path, capsys):
+    """Found by review: the README's two commands into one folder left the first's 56 CSVs and its
+    figures beside the second's summary. A reproduce now replaces its folder whole."""
+    out = tmp_path / "out"
+    assert main(["reproduce", "--out", str(out), "--only", "fig8-h0-6*", "--workers", "1", "--no-progress"]) == 0
+    assert len(list((out / "runs").glob("*.csv"))) == 4  # h0 60 and 65, each wire
+    assert main(["reproduce", "--out", str(out), "--only", QUICK[1], "--workers", "1", "--no-progress"]) == 0
+    assert sorted(p.name for p in (out / "runs").glob("*.csv")) == [f"{QUICK[1]}.csv"]
+    assert list(json.loads((out / "summary.json").read_text())) == [QUICK[1]]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left beside it
+
+
+def test_a_folder_holding_other_files_is_refused_before_any_run(tmp_path, capsys):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    assert main(["reproduce", "--out", str(out), "--only", QUICK[0], "--no-progress"]) == 2
+    assert "--out " + str(out) + ": holds notes.txt, which reproduce does not write" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_an_interrupted_reproduce_leaves_the_folder_as_it_was(tmp_path, capsys, monkeypatch):
+    """Found by review: Ctrl-C while writing left a summary.json without its report.md."""
+    from smafinger.paper import runner
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")  # an earlier reproduce's
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "_write_files", interrupted)
+    assert main(["reproduce", "--out", str(out), "--only", QUICK[0], "--workers", "1", "--no-progress"]) == 130
+    assert "no output was written; --out is as it was" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["out", "summary.json"]
+    assert (out / "summary.json").read_text() == "{}"
+
+
+def test_investigate_without_the_scenarios_it_reads_is_refused(tmp_path, capsys):
+    """Found by review: with only the two v1 on-reach runs (the old default's trigger) its tables said
+    'never' (not completed) for every study run that was not selected, and drew findings from them."""
+    argv = ["reproduce", "--out", str(tmp_path / "x"), "--no-progress", "--only", "fig15-independent-v1",
+            "--only", "fig15-cooperative-v1"]
+    assert main(argv + ["--investigate"]) == 2
+    assert "--investigate needs the scenarios its tables read; not selected: fig12-extension-v1" in \
+        capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+    from smafinger.paper.runner import check_investigate
+
+    assert check_investigate(["fig15-independent-v1", "fig15-cooperative-v1"], None) is False  # was True

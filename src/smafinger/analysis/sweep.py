@@ -293,6 +293,11 @@ def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tu
         say.stop()
         saver.flush()
         raise SweepInterrupted(done, total, saver.pdir) from None
+    except batch.BatchError as exc:  # the pool broke: what finished is saved, as after Ctrl-C
+        say.stop()
+        saver.flush()
+        raise batch.BatchError(f"{exc}; after {done} of {total} runs, finished runs are saved in {saver.pdir} - run "
+                         "the same sweep again to resume") from None
     except BaseException:
         say.stop()
         saver.flush()

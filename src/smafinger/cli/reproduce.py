@@ -11,7 +11,7 @@ from .common import progress_display, progress_option
 from .errors import UsageError, WorkFailed, command, reading_input
 
 
-@command()
+@command(interrupted="no output was written; --out is as it was")
 def reproduce(
     out: Path = typer.Option(Path("smafinger-reproduce"), "--out", metavar="DIR", help="output folder (created if needed)"),
     only: Optional[List[str]] = typer.Option(
@@ -20,24 +20,22 @@ def reproduce(
     workers: Optional[int] = typer.Option(None, "--workers", metavar="N", help="worker processes (default: every available core)"),
     investigate: Optional[bool] = typer.Option(
         None, "--investigate/--no-investigate",
-        help="run the full-cycle readings of Fig. 15 (default: when both Fig. 15 scenarios run)"),
+        help="run the full-cycle readings and studies of Fig. 15 (default: when every scenario they read runs)"),
     progress: Optional[bool] = progress_option(),
 ):
     """Run the paper's scenarios; write its figures, a CSV per run, summary.json and report.md."""
     from ..engine.forking import start_forkserver  # the standard library only
 
     start_forkserver(workers)  # its imports and kernel loading overlap this process's own
+    from ..paper.runner import check_investigate, check_out_dir, select
     from ..paper.runner import reproduce as run
-    from ..paper.runner import select
 
     with reading_input():
-        select(only)  # an unknown name is refused before anything is made
+        # an unknown name, or --investigate without its scenarios, is refused before anything is made
+        check_investigate([s.name for s in select(only)], investigate)
     if workers is not None and workers < 1:
         raise UsageError(f"--workers {workers}: must be >= 1")
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: is a file; give a folder (created if needed)")
-    if not out.exists() and not out.parent.is_dir():
-        raise UsageError(f"--out {out}: folder {out.parent} does not exist")
+    check_out_dir(out)  # before any run: a file, a missing parent, a folder holding other files
     with progress_display(progress) as display:
         res = run(out, only=only, workers=workers, progress=display, investigate=investigate)
     _print(res)
@@ -55,13 +53,16 @@ def _print(res) -> None:
     table = Table(title=f"Gilardi et al. (2010) reproduced: {len(res.runs)} runs in {res.wall_s:.1f} s")
     for col in ("Figure", "Claim", "Paper", "Holds"):
         table.add_column(col, overflow="fold")
-    skipped = 0
+    skipped, broken = 0, 0
     for o in res.claims:
         if o.verdict is Verdict.NOT_RUN:
-            skipped += 1
+            skipped += not o.runs_failed
+            broken += bool(o.runs_failed)
             continue
         table.add_row(o.claim.figure, o.claim.statement, o.claim.paper, o.verdict.value)
     console.print(table)
+    if broken:
+        console.print(f"{broken} claim(s) not evaluated: a run they need failed")
     if skipped:
         console.print(f"{skipped} claim(s) not run: their scenarios were not selected")
     console.print(f"smafinger's values, notes and the full-cycle investigation: {res.out_dir / 'report.md'}")

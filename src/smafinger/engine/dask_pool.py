@@ -277,12 +277,10 @@ class DaskPool(SerialPool):
                     try:
                         res = f.result()
                     except WorkerVersionError as exc:
-                        raise BatchError(f"{exc}: install the same version on every worker; finished runs are "
-                                         "kept") from None
+                        raise BatchError(f"{exc}: install the same version on every worker") from None
                     except Exception as exc:  # KilledWorker and the like
                         first = str(exc).splitlines()[0] if str(exc) else ""
-                        raise BatchError(f"a Dask task failed ({type(exc).__name__}: {first}); finished runs are "
-                                         "kept") from None
+                        raise BatchError(f"a Dask task failed ({type(exc).__name__}: {first})") from None
                     f.release()
                     yield res
                 fill()

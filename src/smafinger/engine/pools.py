@@ -243,7 +243,7 @@ class LocalPool(SerialPool):
                     try:
                         res = f.result()
                     except BrokenProcessPool as exc:
-                        raise BatchError(f"a worker process died ({exc}); finished runs are kept") from None
+                        raise BatchError(f"a worker process died ({exc})") from None  # the caller says what it kept
                     undelivered -= 1
                     fill()
                     yield res

@@ -45,6 +45,8 @@ class Outcome:
     shows: str = ""
     note: str = ""
     failed: tuple[str, ...] = ()
+    #: NOT_RUN: the claim's runs that were selected and failed (empty: they were not selected)
+    runs_failed: tuple[str, ...] = ()
 
     def explain(self) -> str:
         """One paragraph for a test failure: the claim, the verdict, what failed, the numbers."""
@@ -106,10 +108,14 @@ class Claim:
             text += "; partly: " + "; ".join(c.text for c in self.fallback)
         return text
 
+    def _names(self, runs: Mapping[str, Any]) -> tuple[str, ...]:
+        """The claim's scenarios; a claim naming none reads every scenario run."""
+        return self.scenarios or tuple(k for k, r in runs.items() if r.scenario is not None)
+
     def available(self, runs: Mapping[str, Any]) -> list | None:
         """The claim's successful runs (``scenarios`` then ``also``), or ``None`` if too
         few of ``scenarios`` ran."""
-        names = self.scenarios or tuple(k for k, r in runs.items() if r.scenario is not None)
+        names = self._names(runs)
         have = [runs[n] for n in names if n in runs and runs[n].ok]
         need = len(names) if self.min_runs is None else self.min_runs
         if not names or len(have) < need:
@@ -121,7 +127,8 @@ class Claim:
         and ``scenario``)."""
         have = self.available(runs)
         if have is None:
-            return Outcome(self, Verdict.NOT_RUN, {})
+            return Outcome(self, Verdict.NOT_RUN, {},
+                           runs_failed=tuple(n for n in self._names(runs) if n in runs and not runs[n].ok))
         values = self.measure(have)
         note = self.note(values) if callable(self.note) else self.note
         passed = [c.test(values) for c in self.checks]

@@ -21,12 +21,27 @@ STRATEGY_COLORS = {"independent": "tab:blue", "cooperative": "tab:red"}
 SETTLED_DEG = 0.05
 
 
+#: the figures' style, applied inside each figure's drawing only (the caller's rcParams are left alone)
+STYLE = {"font.size": 9, "axes.titlesize": 9.5, "legend.fontsize": 8, "axes.grid": True, "grid.alpha": 0.3}
+
+
 def _plt():
     import matplotlib.pyplot as plt  # on the caller's backend (the command line's: Agg, cli.main)
 
-    plt.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "legend.fontsize": 8,
-                         "axes.grid": True, "grid.alpha": 0.3})
     return plt
+
+
+def _styled(draw):
+    """``draw`` under :data:`STYLE` (``matplotlib.rc_context``): it used to update the process's
+    rcParams for good, so the bench's figures drawn after a reproduce in the same process came
+    out different from those drawn in a fresh worker."""
+    import functools
+
+    @functools.wraps(draw)
+    def styled(*args, **kwargs):
+        with _plt().rc_context(STYLE):
+            return draw(*args, **kwargs)
+    return styled
 
 
 def _save(fig, path: Path) -> None:
@@ -44,6 +59,7 @@ def _panels(runs: list, panels: tuple[str, ...]) -> list[list]:
     return [[r for r in runs if r.ok and r.scenario.panel == p] for p in panels]
 
 
+@_styled
 def openloop(runs: list, title: str, path: Path) -> None:
     """2 x 2: rows upper / lower wire heated; (a) heating phase, (b) cooling phase (Figs. 7-8)."""
     plt = _plt()
@@ -76,6 +92,7 @@ def openloop(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
+@_styled
 def cooling_phase(runs: list, title: str, path: Path, panel: str, zoom_deg: float | None = None,
                   marks=None) -> None:
     """Fig. 11: the angle (and, with ``zoom_deg``, a close-up of +-zoom_deg around the last
@@ -117,6 +134,7 @@ def cooling_phase(runs: list, title: str, path: Path, panel: str, zoom_deg: floa
     _save(fig, path)
 
 
+@_styled
 def onoff_cycles(runs: list, title: str, path: Path) -> None:
     """Fig. 10(a): open-loop on/off cycles. (a) the air inside the casing (two-node model),
     (b) the wire's temperature, (c) the joint angle, (d) the cooling time of each cycle's move,
@@ -153,6 +171,7 @@ def onoff_cycles(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
+@_styled
 def moves(runs: list, title: str, path: Path) -> None:
     """Fig. 12: closed-loop move with one actuator and the return through its cooling phase
     (columns extension / flexion): angle and agonist temperature."""
@@ -177,6 +196,7 @@ def moves(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
+@_styled
 def returns(runs: list, title: str, path: Path) -> None:
     """Fig. 13: the return from a move, agonist only vs co-operative (columns extension /
     flexion), on a time axis from the start of the return."""
@@ -201,6 +221,7 @@ def returns(runs: list, title: str, path: Path) -> None:
     _save(fig, path)
 
 
+@_styled
 def cycles(runs: list, title: str, path: Path, panels: dict[str, str], paper_s: dict[str, float]) -> None:
     """Fig. 15: full cycles, one panel per reading (``panels``: panel -> title). Dashed: the
     time at which each run reaches its last target (``elapsed_s``, given in the legend with
@@ -240,6 +261,7 @@ def cycles(runs: list, title: str, path: Path, panels: dict[str, str], paper_s: 
     _save(fig, path)
 
 
+@_styled
 def profiles(runs: list, title: str, path: Path) -> None:
     """The authors' 2020 example profiles (one column each): angle and both wires' temperatures."""
     plt = _plt()

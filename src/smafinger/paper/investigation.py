@@ -124,6 +124,13 @@ def reading_tasks() -> list[tuple[str, RunSpec]]:
             if k == "independent" or rd.cooperative is not None]
 
 
+def needed_scenarios() -> tuple[str, ...]:
+    """The scenarios whose runs the investigation's tables read: the v1 on-reach pair the
+    readings vary and every study's scenarios. Run without one, its cells would say ``never``
+    (not completed) for a run that was never made."""
+    return tuple(dict.fromkeys([*REACH.values(), *(n for s in studies.STUDIES for n in s.scenarios)]))
+
+
 def tasks(names: Iterable[str] | None = None) -> list[tuple[str, RunSpec]]:
     """``(key, spec)`` of every run of the investigation: the v1 readings and the studies'
     variants (:mod:`.studies`; of the scenarios ``names`` only, if given)."""

@@ -72,7 +72,7 @@ def _note(o: Outcome) -> str:
 
 
 def claims_table(outcomes: list[Outcome]) -> list[str]:
-    """The claims evaluated, then one line naming those whose runs were not selected."""
+    """The claims evaluated, then a line naming those whose runs failed and one naming those not selected."""
     lines = ["## The paper's claims", "", *_CLAIMS_HEADER]
     for o in outcomes:
         if o.verdict is Verdict.NOT_RUN:
@@ -80,7 +80,12 @@ def claims_table(outcomes: list[Outcome]) -> list[str]:
         c = o.claim
         cells = (c.figure, c.statement, c.paper, o.shows, o.verdict.value, _note(o))
         lines.append("| " + " | ".join(md_escape(x) for x in cells) + " |")
-    skipped = [o.claim for o in outcomes if o.verdict is Verdict.NOT_RUN]
+    broken = [o for o in outcomes if o.verdict is Verdict.NOT_RUN and o.runs_failed]
+    skipped = [o.claim for o in outcomes if o.verdict is Verdict.NOT_RUN and not o.runs_failed]
+    if broken:
+        lines += ["", f"{len(broken)} claim(s) not evaluated because a run failed: "
+                  + "; ".join(f"{o.claim.figure}: {o.claim.statement} ({', '.join(o.runs_failed)} failed)"
+                              for o in broken) + "."]
     if skipped:
         lines += ["", f"{len(skipped)} claim(s) not run (their scenarios were not selected): "
                   + "; ".join(f"{c.figure}: {c.statement}" for c in skipped) + "."]

@@ -33,7 +33,6 @@ from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
 from .derived import Derivation, Run, derive
-from .fig15 import REACH_V1
 from .issue10 import study_tables
 from .report import write_report
 
@@ -207,6 +206,55 @@ def _write_file(job: _FigureFile | _RunCsv) -> None:
     job.write()
 
 
+#: what a reproduce writes into its folder: a folder holding anything else is refused (a new
+#: reproduce replaces the folder whole, so that no earlier run's file stays beside the new ones)
+OWN_FILES = ("summary.json", "report.md", "investigation.json", "*.png")
+OWN_RUN_FILES = ("*.csv", "*.provenance.json")
+
+
+def check_out_dir(out_dir: str | Path) -> None:
+    """:class:`~smafinger.files.OutputError` (bad input) unless ``out_dir`` can take a reproduce:
+    new (its parent a folder), empty, or holding only what an earlier reproduce wrote."""
+    from ..files import OutputError
+
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputError(f"--out {out_dir}: is a file; give a folder (created if needed)")
+    import os
+
+    if not out_dir.parent.is_dir():
+        raise OutputError(f"--out {out_dir}: folder {out_dir.parent} does not exist")
+    if not os.access(out_dir.parent, os.W_OK | os.X_OK):  # the hidden folder is made beside it
+        raise OutputError(f"--out {out_dir}: folder {out_dir.parent} is not writable")
+    if not out_dir.exists():
+        return
+    foreign = [p for p in out_dir.iterdir()
+               if not (p.is_file() and any(fnmatch.fnmatchcase(p.name, pat) for pat in OWN_FILES))
+               and not (p.name == "runs" and p.is_dir())]
+    runs = out_dir / "runs"
+    if runs.is_dir():
+        foreign += [p for p in runs.iterdir()
+                    if not (p.is_file() and any(fnmatch.fnmatchcase(p.name, pat) for pat in OWN_RUN_FILES))]
+    if foreign:
+        raise OutputError(f"--out {out_dir}: holds {foreign[0].relative_to(out_dir)}, which reproduce does not "
+                          f"write; a reproduce replaces its folder whole: give a new folder, or one only an "
+                          f"earlier reproduce wrote")
+
+
+def check_investigate(names: Iterable[str], investigate: bool | None) -> bool:
+    """Whether to run the Fig. 15 investigation with the scenarios ``names``: by default when
+    every scenario its tables read is among them (:func:`.investigation.needed_scenarios`);
+    asked for without them, ValueError naming the missing ones (found by review: its tables
+    said ``never``, not completed, for the runs that were not selected, and drew findings)."""
+    missing = [n for n in inv.needed_scenarios() if n not in set(names)]
+    if investigate is None:
+        return not missing
+    if investigate and missing:
+        raise ValueError(f"--investigate needs the scenarios its tables read; not selected: {', '.join(missing)} "
+                         f"(run them all: no --only)")
+    return investigate
+
+
 def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: int | None = None,
               progress=False, investigate: bool | None = None) -> ReproduceOutput:
     """Run the scenarios and write figures, CSVs, summary.json, investigation.json and
@@ -215,35 +263,68 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     ``only``: scenario names or glob patterns (default: all). ``investigate``: run the Fig. 15
     readings (default: when both on-reach Fig. 15 scenarios are selected). ``progress``: a
     flag or a :class:`~smafinger.progress.Display`.
+
+    All or nothing: the outputs are written into a hidden folder beside ``out_dir`` and take its
+    place at the end, replacing what an earlier reproduce left there (:func:`check_out_dir`
+    refuses a folder holding anything else). Interrupted or failed before that, the hidden
+    folder is removed and ``out_dir`` is as it was.
     """
-    from ..engine.batch import available_cores
+    import os
+    import shutil
+
+    from ..engine.batch import BatchError, available_cores
 
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
     chosen = select(only)  # before anything is written: a bad name leaves no directory
+    check_out_dir(out_dir)
     names = [s.name for s in chosen]
-    if investigate is None:
-        investigate = all(n in names for n in REACH_V1.values())
+    investigate = check_investigate(names, investigate)
     tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks(names) if investigate else [])
     n_workers = max(1, min(workers or available_cores(), len(tasks)))
-    (out_dir / "runs").mkdir(parents=True, exist_ok=True)
-
-    derivations = inv.derivations() if investigate else {}
-    derivations.update({s.name: s.derive for s in chosen})
-    runs = _simulate(tasks, n_workers, progress, derivations)
-    for s in chosen:
-        runs[s.name].scenario = s
-    scen_runs = {n: runs[n] for n in names}
-    _write_summary(out_dir, scen_runs)
-    figures = _write_files(out_dir, scen_runs, n_workers)
-    rows = inv.table(runs) if investigate else None
-    tables = study_tables(runs) if investigate else None
-    if rows is not None:
-        write_json(out_dir / "investigation.json", {"readings": rows, "studies": tables})
-    outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
-    wall = time.perf_counter() - t0
-    write_report(out_dir / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
+    stage = out_dir.parent / f".{out_dir.name}.partial-{os.getpid()}"
+    try:
+        (stage / "runs").mkdir(parents=True)
+        derivations = inv.derivations() if investigate else {}
+        derivations.update({s.name: s.derive for s in chosen})
+        runs = _simulate(tasks, n_workers, progress, derivations)
+        for s in chosen:
+            runs[s.name].scenario = s
+        scen_runs = {n: runs[n] for n in names}
+        _write_summary(stage, scen_runs)
+        figures = _write_files(stage, scen_runs, n_workers)
+        rows = inv.table(runs) if investigate else None
+        tables = study_tables(runs) if investigate else None
+        if rows is not None:
+            write_json(stage / "investigation.json", {"readings": rows, "studies": tables})
+        outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
+        wall = time.perf_counter() - t0
+        write_report(stage / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
+        _publish(stage, out_dir)
+    except BatchError as exc:  # a worker died: nothing is kept
+        shutil.rmtree(stage, ignore_errors=True)
+        raise BatchError(f"{exc}; no output was written ({out_dir} is as it was)") from None
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+    figures = [out_dir / p.relative_to(stage) for p in figures]
     return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
 
 
-__all__ = ["reproduce", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
+def _publish(stage: Path, out_dir: Path) -> None:
+    """``stage`` renamed to ``out_dir``; an earlier reproduce's folder there moved aside first and
+    removed after (renames within one folder: a reader sees the old outputs or the new)."""
+    import os
+    import shutil
+
+    if out_dir.exists():
+        check_out_dir(out_dir)  # still only an earlier reproduce's files
+        old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
+        out_dir.rename(old)
+        stage.rename(out_dir)
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        stage.rename(out_dir)
+
+
+__all__ = ["reproduce", "check_out_dir", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
