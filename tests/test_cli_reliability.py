@@ -267,3 +267,15 @@ def test_a_sweep_of_another_mechanism_tabulates_its_own_columns(tmp_path, capsys
     assert rc == 0, err
     table = pd.read_parquet(tmp_path / "t.parquet")
     assert len(table) == 2 and table["position_max_m"].notna().all() and table["theta_max_deg"].isna().all()
+
+
+def test_a_changed_scenario_run_records_what_changed(here, capsys):
+    """Found by review: `--scenario fig12-extension-v1 --set M_SF_Nm=0.02` was recorded as that scenario alone."""
+    rc, _, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--set", "M_SF_Nm=0.02", "--t-end", "1",
+                   "--summary", "s.json")
+    assert rc == 0
+    prov = json.loads((here / "s.json").read_text())["provenance"]
+    assert prov["scenario"] == "fig12-extension-v1"
+    assert prov["scenario_changes"] == ["--set M_SF_Nm=0.02", "--t-end 1.0"]
+    rc, _, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "1", "--summary", "u.json")
+    assert "--t-end 1.0" in json.loads((here / "u.json").read_text())["provenance"]["scenario_changes"]

@@ -164,7 +164,14 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
                 tol_deg=option(tol_deg, "--tol-deg"), hold_s=option(hold_s, "--hold-s"),
                 strategy=option(strategy, "--strategy"), profile=option(profile, "--profile"),
                 t_end_s=option(t_end, "--t-end"))
-        return spec, {"scenario": scenario}
+        # the name stands for the scenario's own run: a changed one says what changed (found by review)
+        runs_flags = set(given(ctx, "strategy", "profile", "t_end", "tol_deg", "hold_s", "dt", "method", "pwm"))
+        changes = [f"--set {a}" for a in set_ or []] + [
+            f"{flag} {value}" for flag, value in (("--strategy", strategy), ("--profile", profile),
+                                                  ("--t-end", t_end), ("--tol-deg", tol_deg), ("--hold-s", hold_s),
+                                                  ("--dt", dt), ("--method", method), ("--pwm", pwm))
+            if flag in runs_flags]
+        return spec, {"scenario": scenario, **({"scenario_changes": changes} if changes else {})}
     kind, program = programs[0] if programs else ("voltage", None)
     p = load_params(params, set_)
     with reading_input():

@@ -101,6 +101,16 @@ class Scenario:
                 "overrides": list(self.overrides.texts()), "strategy": self.strategy,
                 "profile": self.profile, "voltage": self.voltage, "t_end_s": self.t_end_s}
 
+    def definition_sha256(self) -> str:
+        """SHA-256 of what the name stands for: the :meth:`definition` but its words (figure,
+        description). A changed definition needs a new name (``-v2``); ``tests/golden/
+        scenario_definitions.json`` records every name's and a test holds them."""
+        import hashlib
+        import json
+
+        d = {k: v for k, v in self.definition().items() if k not in ("figure", "description")}
+        return hashlib.sha256(json.dumps(d, sort_keys=True).encode()).hexdigest()
+
 
 #: ``plot(runs, title, path)``: draws a figure's runs into ``path`` (see :mod:`.figures`)
 Plot = Callable[[list, str, Path], None]

@@ -3,7 +3,12 @@
 Each scenario reproduces one curve of a figure of Gilardi, Haslam, Bundhoo & Park,
 Robotica 28(5):675-687 (2010), or one of the two example profiles of the authors' public
 2020 Simulink model. A name ends in a version (``-v1``): a scenario whose definition changes
-gets a new version, so that a name always means the same run.
+gets a new version, so that a name always means the same definition: the parameter set (by its
+name), its overrides, the strategy, the profile or drive program and the duration
+(:meth:`.Scenario.definition_sha256`, recorded in ``tests/golden/scenario_definitions.json``).
+Its results follow the model and the named sets' values: the golden record
+(``tests/golden/paper_runs.json``) holds them, and every change to them is named in
+``docs/changes/``.
 
 >>> from smafinger import scenarios
 >>> s = scenarios.get("fig8-h0-60-upper-v1")
