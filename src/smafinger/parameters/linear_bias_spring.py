@@ -15,7 +15,13 @@ linear-bias-spring --out rig.toml``) or fit it to your recordings. Sources:
   open air, so heating and cooling share it. Time constant M_w C_p / (h A_w) = 6.5 s.
 - Bias spring 60 N/m with an 8 N preload (wire stress 41 MPa at the start), 20 g slider: the
   usual range of such rigs (40-80 N/m, 10-50 g).
-- Drive: a 12 V supply switched at 1 kHz (full on: 2.9 A, 35 W); the controller runs at 100 Hz.
+- Drive: a 12 V supply switched at 1 kHz (full on: 2.9 A, 35 W, through the R_w that Eq. (11)
+  heats with); the controller runs at 100 Hz.
+- Not matched to R_w: the resistance as sensed (``model.resistance``, the ``resistivity_*``
+  fields) keeps the MAS model's resistivities (89 / 102 micro-ohm cm), so the ``R_wire_ohm``
+  column reads 4.6-5.4 ohm where the heating uses 4.1 ohm. Self-sensing reads the resistance
+  relative to its value at rest, so only that column's level is off; set the ``resistivity_*``
+  fields to your wire's measured values.
   PID gains: a starting point (1 mm of error gives 30 % duty; it reaches 10 mm and then 4 mm
   within 0.5 mm), to be tuned.
 
