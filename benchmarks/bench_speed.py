@@ -33,7 +33,7 @@ against compiling first.
 Usage::
 
     PYTHONPATH=src python benchmarks/bench_speed.py [--repeat 7] [--ref-dt 1e-6] [--cold] [--legacy-src PATH]
-                                                    [--only process]
+                                                    [--only process] [--case TEXT]
 
 Goals (issue 11): full cycle <= 2 ms engine loop at <= 0.05 deg RMS and <= 0.3 deg max error;
 ``--help`` <= 0.3 s; cached ``simulate`` process <= 1 s; first result <= 10 s.
@@ -355,10 +355,19 @@ def main() -> None:
                     help="src folder of smafinger 0.1 (commit ff21ad0) to measure it side by side")
     ap.add_argument("--only", choices=("process",), default=None,
                     help="run only this section (process: the whole-process times)")
+    ap.add_argument("--case", action="append", default=None, metavar="TEXT",
+                    help="run only the cases whose label contains TEXT (repeatable), and nothing else")
     args = ap.parse_args()
     print(f"bench_speed: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} (1 min)")
     if args.only == "process":
         bench_process(args.cold, args.repeat)
+        return
+    if args.case:
+        chosen = [c for c in CASES if any(text in c[0] for text in args.case)]
+        if not chosen:
+            ap.error(f"--case {args.case}: no case label contains it; the cases: {[c[0] for c in CASES]}")
+        for c in chosen:
+            bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt)
         return
     results = {c[0]: bench_case(*c, repeat=args.repeat, ref_dt=args.ref_dt) for c in CASES}
     bench_legacy(results[CASES[0][0]], args.legacy_src, args.repeat)
