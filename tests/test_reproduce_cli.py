@@ -146,3 +146,18 @@ def test_investigate_without_the_scenarios_it_reads_is_refused(tmp_path, capsys)
     from smafinger.paper.runner import check_investigate
 
     assert check_investigate(["fig15-independent-v1", "fig15-cooperative-v1"], None) is False  # was True
+
+
+def test_a_dead_worker_leaves_nothing_and_says_so(tmp_path, capsys, monkeypatch):
+    """Found by review: 'finished runs are kept' was printed and nothing was kept."""
+    from smafinger.engine.pools import BatchError
+    from smafinger.paper import runner
+
+    def dies(*args, **kwargs):
+        raise BatchError("a worker process died (killed)")
+
+    monkeypatch.setattr(runner, "_simulate", dies)
+    assert main(["reproduce", "--out", str(tmp_path / "o"), "--only", QUICK[0], "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert "a worker process died (killed); no output was written" in err and "kept" not in err
+    assert list(tmp_path.iterdir()) == []

@@ -781,3 +781,27 @@ def test_traces_taken_at_another_interval_are_taken_again(tmp_path):
     assert np.allclose(np.diff(tr[tr["point"] == 0]["t_s"]), 0.5)
     assert traces_interval(sw.traces_path(out)) == 0.5
     assert run_sweep(second, out, workers=1, traces=True).ran == 0  # the same interval again: all finished
+
+
+def test_a_broken_pool_says_the_finished_runs_are_saved_and_resumable(tmp_path, monkeypatch):
+    """The pool's own message no longer claims what its caller keeps (reproduce keeps nothing);
+    the sweep, which does keep its finished runs, says so and where."""
+    from smafinger.engine import pools
+
+    spec = parse_spec({"base": {"t_end_s": 0.5, "profile": "0:-30"}, "sweep": {"chunk_size": 1},
+                       "vary": {"V_H_V": [6.0, 7.0, 8.0, 9.0]}})
+    real = pools.SerialPool.map_tasks  # what workers=1 runs on
+
+    def breaks_after_one(self, fn, items):
+        for k, res in enumerate(real(self, fn, items)):
+            if k == 1 and fn is not sw._check_item:  # the run pass, not the check pass
+                raise pools.BatchError("a worker process died (killed)")
+            yield res
+
+    monkeypatch.setattr(pools.SerialPool, "map_tasks", breaks_after_one)
+    with pytest.raises(pools.BatchError, match=r"a worker process died \(killed\); after 1 of 4 runs, finished runs "
+                                               r"are saved in .* - run the same sweep again to resume"):
+        run_sweep(spec, tmp_path / "t.parquet", workers=1)
+    monkeypatch.setattr(pools.SerialPool, "map_tasks", real)
+    rep = run_sweep(spec, tmp_path / "t.parquet", workers=1)
+    assert rep.resumed == 1 and rep.ran == 3
