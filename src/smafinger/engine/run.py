@@ -372,10 +372,20 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         Default ``$SMAFINGER_ENGINE``, else ``auto``: the compiled kernel if cached, else a
         short run interpreted (the same equations in plain Python; 1.2 s for the 45 s cycle)
         while the kernel compiles in the background (:mod:`.interpreted`).
+    progress : bool or smafinger.progress.Display
+        Show the simulated time as the run goes (a terminal's progress bar).
 
     Returns
     -------
     SimulationResult
+
+    Raises
+    ------
+    ParameterError, ProfileError, ValueError, TypeError
+        Bad input, before anything runs; the message names the argument or field and the value.
+    SimulationError
+        The state became NaN or Inf (a numerical blow-up), with the time and the state;
+        :class:`DutyNotANumber` if the controller commanded a duty that is no number.
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
                      tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
