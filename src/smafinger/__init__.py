@@ -1,8 +1,17 @@
-"""smafinger: simulate, control and identify SMA tendon-driven finger joints.
+"""smafinger: simulate, control and identify shape-memory-alloy (SMA) wire actuators.
 
-Implements Gilardi, Haslam, Bundhoo & Park, "A shape memory alloy based tendon-driven
-actuation system for biomimetic artificial fingers, part II: modelling and control",
-Robotica 28(5):675-687 (2010).
+One engine drives two mechanisms: the tendon-driven finger joint of Gilardi, Haslam, Bundhoo &
+Park, "A shape memory alloy based tendon-driven actuation system for biomimetic artificial
+fingers, part II: modelling and control", Robotica 28(5):675-687 (2010), moved by two opposing
+SMA wires (``paper2010`` and the other joint sets), and a single SMA wire pulling a slider
+against a bias spring (``linear-bias-spring``).
+
+Public names: :func:`simulate` (one run of either mechanism), :class:`ParameterSet` (the base
+type of every parameter set; each field range-checked), :class:`TargetProfile` (a closed-loop
+target schedule such as ``"0:-25,reach:-55"``: degrees for the joint, metres for the linear
+rig), :class:`VoltageProgram` (an open-loop drive program: voltages, duties or currents per
+wire), and the errors :class:`SimulationError`, :class:`ParameterError` and
+:class:`ProfileError`.
 
 The public names are imported on first use (PEP 562 ``__getattr__``): ``import smafinger``
 alone, as ``smafinger --help`` does, does not load the numba-compiled engine;

@@ -10,8 +10,10 @@ PWM period t_P and ``low`` (V_L) for the rest (Fig. 6). Three ways to put that i
   proportional to the drive's square (Eq. 11: V^2 / R_w, or I^2 R_w), so the heat, and the
   electrical energy, delivered per period are exact; what is lost is the temperature ripple
   within a period. Valid when t_P is far below the wire's thermal time constant
-  M_w C_p / (h A_w) (about 1 s for the paper's wire against t_P = 1 ms: the ripple is
-  P' t_P / (M_w C_p), 0.03 degC at 8 V). Steps need not end at PWM edges, so they can be long.
+  M_w C_p / (h A_w): for the paper's wire 9.6 s at ``paper2010``'s heating h0 = 20 W/m^2K,
+  4.7 s at its cooling h0 = 41 and 2.8 s at Table II's h0 = 70 (the h2 T^2 term shortens them
+  by up to a fifth at 100 degC), against t_P = 1 ms; the ripple is P' t_P / (M_w C_p),
+  0.03 degC at 8 V. Steps need not end at PWM edges, so they can be long.
 - ``sampled``: the drive is read at each stage time of the integrator, as the authors' Simulink
   model does (``authors-ode4``; its control block ``SMA1_Control_Signal.m``): the stage times
   are those of Simulink's fixed-step ode4, in floating point: T0 = n h, T0 + 0.5 h (twice)
