@@ -239,15 +239,13 @@ def test_spring_slack_inverse_at_high_tension():
     assert not disagreements(p, s, u, RTOL_RATE)
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "model/wire.py wire_rates: with latent heat, dT/dt is solved with the unfloored stress rate of "
-    "Eq. (7b); a slack tendon's stress is then floored at 0 (model/constitutive.py stress_rate), so "
-    "dxi/dt keeps xi_sigma times a stress rate the tendon does not have"))
 def test_latent_heat_of_a_slack_tendon():
     """A slack upper tendon (sigma = 0) that slackens further, heated inside its band, dH = 24 kJ/kg.
 
     Its stress stays 0 (a tendon only pulls), so dxi/dt = xi_T dT/dt and the latent heat takes
-    only that. Measured: the model's dT/dt 5.047 degC/s against 5.486 (8 % low).
+    only that. Was a strict xfail: the model solved dT/dt with the unfloored stress rate of Eq.
+    (7b), 5.047 degC/s against 5.486 (8 % low); model/wire.py ``_strain_driven`` now solves it
+    with the floored one.
     """
     p = get("paper2010").replace(hysteresis="authors2020", latent_heat_J_kg=24e3)
     s = Vars(math.radians(-30.0), 0.5, 0.0, (WireVars(95.0, 0.0), WireVars(30.0, 5e7)))

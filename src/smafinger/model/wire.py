@@ -108,10 +108,15 @@ def algebraic_stress_rate(wire, T, sigma, branch, dT_dt, dpath_dt):
 @njit(cache=True, forceinline=True)
 def _strain_driven(wire, dT0, D_eq, deps, xT, xs, sigma):
     """(dT/dt, dsigma/dt, dxi/dt) of the rate law at strain rate ``deps`` (Eqs. 7b, 11 with the
-    latent heat): T' and sigma' solved together, dxi/dt = xi_T T' + xi_sigma sigma'."""
+    latent heat): T' and sigma' solved together, dxi/dt = xi_T T' + xi_sigma sigma'. A slack
+    tendon's stress rate is floored at 0 (:func:`stress_rate`): its T' is then solved with
+    sigma' = 0, so that the latent heat takes dxi/dt = xi_T T' alone (it took xi_sigma times the
+    unfloored rate, 8 % on dT/dt in the oracle's case, tests/test_oracle.py)."""
     den = 1.0 + D_eq * wire.eps_R * xs
     dT = latent_heat_rate(dT0, D_eq * deps / den, D_eq * wire.eps_R * xT / den, xT, xs, wire)
     dsigma = stress_rate(D_eq, deps, wire.eps_R, xT, xs, dT, sigma)
+    if sigma <= 0.0 and dsigma == 0.0:  # slack and held there: no stress rate to couple
+        dT = latent_heat_rate(dT0, 0.0, 0.0, xT, xs, wire)
     return dT, dsigma, xT * dT + xs * dsigma
 
 
