@@ -39,6 +39,16 @@ class Segment:
 
 @dataclass(frozen=True)
 class TargetProfile:
+    """A closed-loop target schedule: segments, each a target from its start time on.
+
+    :meth:`parse` reads the command line's text, ``"T:TARGET[:ENABLE],..."``: T in seconds (the
+    first 0), or ``reach`` to start once the previous target is reached (within the run's
+    tolerance for its hold time); TARGET in the mechanism's user unit (degrees for the joint,
+    metres for the linear rig); ENABLE which actuators the strategy may use (``auto``, ``upper``,
+    ``lower``, ``both`` or ``all``, ``none``; ``wire`` on the linear rig). Validated on construction
+    (:class:`ProfileError` naming the segment).
+    """
+
     segments: tuple[Segment, ...]
 
     def __post_init__(self) -> None:
