@@ -104,7 +104,7 @@ def test_a_second_reproduce_replaces_the_first_whole(tmp_path, capsys):
     assert main(["reproduce", "--out", str(out), "--only", QUICK[1], "--workers", "1", "--no-progress"]) == 0
     assert sorted(p.name for p in (out / "runs").glob("*.csv")) == [f"{QUICK[1]}.csv"]
     assert list(json.loads((out / "summary.json").read_text())) == [QUICK[1]]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left beside it
+    assert sorted(p.name for p in out.iterdir()) == ["fig08-h0.png", "report.md", "runs", "summary.json"]
 
 
 def test_a_folder_holding_other_files_is_refused_before_any_run(tmp_path, capsys):
@@ -130,7 +130,7 @@ def test_an_interrupted_reproduce_leaves_the_folder_as_it_was(tmp_path, capsys, 
     monkeypatch.setattr(runner, "_write_files", interrupted)
     assert main(["reproduce", "--out", str(out), "--only", QUICK[0], "--workers", "1", "--no-progress"]) == 130
     assert "no output was written; --out is as it was" in capsys.readouterr().err
-    assert sorted(p.name for p in tmp_path.rglob("*")) == ["out", "summary.json"]
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["out", "summary.json"]  # its hidden folder removed
     assert (out / "summary.json").read_text() == "{}"
 
 
@@ -161,3 +161,31 @@ def test_a_dead_worker_leaves_nothing_and_says_so(tmp_path, capsys, monkeypatch)
     err = capsys.readouterr().err
     assert "a worker process died (killed); no output was written" in err and "kept" not in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_only_exact_names_of_a_reproduce_are_replaced(tmp_path, capsys):
+    """Found by review: any *.png or runs/*.csv counted as a reproduce's, and the whole folder was
+    replaced, deleting them."""
+    for folder, name in ((tmp_path / "a", "holiday.png"), (tmp_path / "b", "runs/my-measurements.csv")):
+        (folder / "runs").mkdir(parents=True)
+        (folder / name).write_text("mine")
+        (folder / "summary.json").write_text("{}")
+        assert main(["reproduce", "--out", str(folder), "--only", QUICK[0], "--no-progress"]) == 2
+        assert f"holds {name}, which reproduce does not write" in capsys.readouterr().err
+        assert (folder / name).read_text() == "mine"
+
+
+def test_the_current_folder_and_a_symlink_can_take_a_reproduce(tmp_path, capsys, monkeypatch):
+    """Found by review: --out . staged its files in ./..partial-PID, refused them at the end and
+    lost the runs; a symlinked --out was replaced by a real folder."""
+    here = tmp_path / "here"
+    here.mkdir()
+    monkeypatch.chdir(here)
+    argv = ["reproduce", "--only", QUICK[0], "--workers", "1", "--no-progress", "--out"]
+    assert main(argv + ["."]) == 0 and main(argv + ["."]) == 0
+    assert sorted(p.name for p in here.iterdir()) == ["fig08-h0.png", "report.md", "runs", "summary.json"]
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    assert main(argv + [str(tmp_path / "link")]) == 0 and main(argv + [str(tmp_path / "link")]) == 0
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "summary.json").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["here", "link", "real"]

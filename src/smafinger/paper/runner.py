@@ -206,39 +206,50 @@ def _write_file(job: _FigureFile | _RunCsv) -> None:
     job.write()
 
 
-#: what a reproduce writes into its folder: a folder holding anything else is refused (a new
-#: reproduce replaces the folder whole, so that no earlier run's file stays beside the new ones)
-OWN_FILES = ("summary.json", "report.md", "investigation.json", "*.png")
-OWN_RUN_FILES = ("*.csv", "*.provenance.json")
+#: the hidden folder a reproduce writes into, inside its ``--out`` (``.partial-XXXXXXXX``)
+STAGE_PREFIX = ".partial-"
+
+
+def own_files() -> tuple[frozenset[str], frozenset[str]]:
+    """The names a reproduce writes: (in its folder, in its ``runs/``). Exact names, so that a
+    file of the user's that merely looks like one (``holiday.png``) is never taken for it."""
+    top = {"summary.json", "report.md", "investigation.json"} | {f"{f.key}.png" for f in scn.FIGURES}
+    runs = {f"{n}{suffix}" for n in scn.names() for suffix in (".csv", ".provenance.json")}
+    return frozenset(top), frozenset(runs)
+
+
+def _foreign(out_dir: Path) -> list[Path]:
+    """What ``out_dir`` holds that no reproduce writes (a killed reproduce's hidden folder is its own)."""
+    top, runs = own_files()
+    out = [p for p in out_dir.iterdir()
+           if not (p.is_file() and p.name in top) and not (p.name == "runs" and p.is_dir())
+           and not (p.is_dir() and p.name.startswith(STAGE_PREFIX))]
+    if (out_dir / "runs").is_dir():
+        out += [p for p in (out_dir / "runs").iterdir() if not (p.is_file() and p.name in runs)]
+    return out
 
 
 def check_out_dir(out_dir: str | Path) -> None:
     """:class:`~smafinger.files.OutputError` (bad input) unless ``out_dir`` can take a reproduce:
-    new (its parent a folder), empty, or holding only what an earlier reproduce wrote."""
+    new (its parent a writable folder), or a writable folder that is empty or holds only what
+    a reproduce writes (:func:`own_files`)."""
+    import os
+
     from ..files import OutputError
 
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputError(f"--out {out_dir}: is a file; give a folder (created if needed)")
-    import os
-
-    if not out_dir.parent.is_dir():
-        raise OutputError(f"--out {out_dir}: folder {out_dir.parent} does not exist")
-    if not os.access(out_dir.parent, os.W_OK | os.X_OK):  # the hidden folder is made beside it
-        raise OutputError(f"--out {out_dir}: folder {out_dir.parent} is not writable")
-    if not out_dir.exists():
-        return
-    foreign = [p for p in out_dir.iterdir()
-               if not (p.is_file() and any(fnmatch.fnmatchcase(p.name, pat) for pat in OWN_FILES))
-               and not (p.name == "runs" and p.is_dir())]
-    runs = out_dir / "runs"
-    if runs.is_dir():
-        foreign += [p for p in runs.iterdir()
-                    if not (p.is_file() and any(fnmatch.fnmatchcase(p.name, pat) for pat in OWN_RUN_FILES))]
+    where = out_dir if out_dir.exists() else Path(os.path.abspath(out_dir)).parent
+    if not where.is_dir():
+        raise OutputError(f"--out {out_dir}: folder {where} does not exist")
+    if not os.access(where, os.W_OK | os.X_OK):
+        raise OutputError(f"--out {out_dir}: folder {where} is not writable")
+    foreign = _foreign(out_dir) if out_dir.exists() else []
     if foreign:
         raise OutputError(f"--out {out_dir}: holds {foreign[0].relative_to(out_dir)}, which reproduce does not "
-                          f"write; a reproduce replaces its folder whole: give a new folder, or one only an "
-                          f"earlier reproduce wrote")
+                          f"write; a reproduce replaces what an earlier one wrote there: give a new folder, or "
+                          f"one only reproduce wrote")
 
 
 def check_investigate(names: Iterable[str], investigate: bool | None) -> bool:
@@ -264,13 +275,14 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     readings (default: when both on-reach Fig. 15 scenarios are selected). ``progress``: a
     flag or a :class:`~smafinger.progress.Display`.
 
-    All or nothing: the outputs are written into a hidden folder beside ``out_dir`` and take its
-    place at the end, replacing what an earlier reproduce left there (:func:`check_out_dir`
-    refuses a folder holding anything else). Interrupted or failed before that, the hidden
-    folder is removed and ``out_dir`` is as it was.
+    All or nothing: the outputs are written into a hidden folder inside ``out_dir``
+    (:data:`STAGE_PREFIX`) and moved into place at the end, after what an earlier reproduce
+    wrote there is removed (:func:`check_out_dir` refuses a folder holding anything else), so
+    no file of an earlier run stays beside the new ones. Interrupted or failed before that, the
+    hidden folder is removed and ``out_dir`` is as it was (a folder it made is removed too).
     """
-    import os
     import shutil
+    import tempfile
 
     from ..engine.batch import BatchError, available_cores
 
@@ -282,9 +294,11 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     investigate = check_investigate(names, investigate)
     tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks(names) if investigate else [])
     n_workers = max(1, min(workers or available_cores(), len(tasks)))
-    stage = out_dir.parent / f".{out_dir.name}.partial-{os.getpid()}"
+    made = not out_dir.exists()
+    out_dir.mkdir(exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=out_dir))
     try:
-        (stage / "runs").mkdir(parents=True)
+        (stage / "runs").mkdir()
         derivations = inv.derivations() if investigate else {}
         derivations.update({s.name: s.derive for s in chosen})
         runs = _simulate(tasks, n_workers, progress, derivations)
@@ -300,31 +314,45 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
         outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
         wall = time.perf_counter() - t0
         write_report(stage / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
-        _publish(stage, out_dir)
-    except BatchError as exc:  # a worker died: nothing is kept
+        check_out_dir(out_dir)  # still only what a reproduce writes
+    except BaseException as exc:
         shutil.rmtree(stage, ignore_errors=True)
-        raise BatchError(f"{exc}; no output was written ({out_dir} is as it was)") from None
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
+        if made:
+            try:
+                out_dir.rmdir()  # made here and empty again
+            except OSError:
+                pass
+        if isinstance(exc, BatchError):  # a worker died: nothing is kept
+            raise BatchError(f"{exc}; no output was written ({out_dir} is as it was)") from None
         raise
+    _publish(stage, out_dir)
     figures = [out_dir / p.relative_to(stage) for p in figures]
     return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
 
 
 def _publish(stage: Path, out_dir: Path) -> None:
-    """``stage`` renamed to ``out_dir``; an earlier reproduce's folder there moved aside first and
-    removed after (renames within one folder: a reader sees the old outputs or the new)."""
-    import os
-    import shutil
+    """Replace what an earlier reproduce wrote in ``out_dir`` by ``stage``'s files: the old ones
+    removed, the new renamed into place (within one folder: no copy), with Ctrl-C held off
+    meanwhile (a Ctrl-C then is let go: the outputs are complete)."""
+    import signal
+    import threading
 
-    if out_dir.exists():
-        check_out_dir(out_dir)  # still only an earlier reproduce's files
-        old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
-        out_dir.rename(old)
-        stage.rename(out_dir)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        stage.rename(out_dir)
+    top, runs = own_files()
+    held = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if held else None
+    try:
+        for p in [out_dir / n for n in top] + [out_dir / "runs" / n for n in runs]:
+            p.unlink(missing_ok=True)
+        (out_dir / "runs").mkdir(exist_ok=True)
+        for p in (stage / "runs").iterdir():
+            p.rename(out_dir / "runs" / p.name)
+        (stage / "runs").rmdir()
+        for p in stage.iterdir():
+            p.rename(out_dir / p.name)
+        stage.rmdir()
+    finally:
+        if held and previous is not None:
+            signal.signal(signal.SIGINT, previous)
 
 
-__all__ = ["reproduce", "check_out_dir", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
+__all__ = ["reproduce", "check_out_dir", "own_files", "STAGE_PREFIX", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
