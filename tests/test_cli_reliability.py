@@ -276,6 +276,6 @@ def test_a_changed_scenario_run_records_what_changed(here, capsys):
     assert rc == 0
     prov = json.loads((here / "s.json").read_text())["provenance"]
     assert prov["scenario"] == "fig12-extension-v1"
-    assert prov["scenario_changes"] == ["--set M_SF_Nm=0.02", "--t-end 1.0"]
-    rc, _, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "1", "--summary", "u.json")
-    assert "--t-end 1.0" in json.loads((here / "u.json").read_text())["provenance"]["scenario_changes"]
+    assert prov["scenario_changes"] == "--set M_SF_Nm=0.02 --t-end 1.0"
+    rc, _, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "1", "--out", "u.mat")
+    assert rc == 0  # a .mat file holds them too (CI caught a list refused there)

@@ -171,7 +171,8 @@ def _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, 
                                                   ("--t-end", t_end), ("--tol-deg", tol_deg), ("--hold-s", hold_s),
                                                   ("--dt", dt), ("--method", method), ("--pwm", pwm))
             if flag in runs_flags]
-        return spec, {"scenario": scenario, **({"scenario_changes": changes} if changes else {})}
+        # one string: every output format holds it (a .mat file's provenance takes no list of strings)
+        return spec, {"scenario": scenario, **({"scenario_changes": " ".join(changes)} if changes else {})}
     kind, program = programs[0] if programs else ("voltage", None)
     p = load_params(params, set_)
     with reading_input():
