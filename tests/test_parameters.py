@@ -185,3 +185,21 @@ def test_an_option_given_twice_in_a_file_is_refused(tmp_path, base):
     f.write_text('base = "paper2010"\nV_H_V = 6\n[options]\nV_H_V = 10\n')  # a parameter in [options]
     with pytest.raises(ParameterError, match=r"unknown option\(s\) in \[options\]: V_H_V"):
         resolve(str(f))
+
+
+def test_a_given_length_taken_back_to_equilibrium_is_refused_and_a_record_is_kept(tmp_path):
+    """Found by review: a given start with its own length, set back to equilibrium under the named
+    set's name, was written by `params --out` and then refused when read back; and a run's record
+    of such a set (made before the refusal existed) no longer replayed."""
+    from smafinger.parameters import from_dict
+
+    p = get("paper2010")
+    given = p.replace(spring_init="given", spring_length_upper_m=0.0176)
+    with pytest.raises(ParameterError, match="spring_length_upper_m = 0.0176 has no effect .* paper2010 has"):
+        given.replace(spring_init="equilibrium")
+    assert given.replace(spring_init="equilibrium", spring_length_upper_m=p.spring_length_upper_m) == p
+    ran = {"mechanism": "joint", **p.to_dict()}
+    ran["spring_length_upper_m"] = 0.0176
+    assert from_dict(ran, record=True).spring_length_upper_m == 0.0176  # as it ran: kept
+    with pytest.raises(ParameterError, match="has no effect"):
+        from_dict(ran)  # as a file's edit: refused

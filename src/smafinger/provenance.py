@@ -95,7 +95,7 @@ def spec_from_definition(definition: Any, where: str = "run definition"):
     if drive is not None and not (isinstance(drive, dict) and set(drive) == {"kind", "program"}):
         raise ProvenanceError(f"{where}: drive = {drive!r} is not {{kind, program}} or null")
     try:
-        p = from_dict({"mechanism": definition["mechanism"], **params})
+        p = from_dict({"mechanism": definition["mechanism"], **params}, record=True)
         run = {k: definition[k] for k in RUN_KEYS if k != "drive"}
         for k in ("dt_s", "method", "pwm"):  # null would mean "the default", which may change
             if run[k] is None:

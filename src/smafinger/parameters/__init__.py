@@ -61,9 +61,10 @@ def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet] = ge
     return _load_toml(path, registry_get)
 
 
-def from_dict(data: dict) -> ParameterSet:
-    """A set from plain values (``to_dict`` plus ``mechanism``, or a parameter file's table)."""
-    return _from_dict(data, get)
+def from_dict(data: dict, record: bool = False) -> ParameterSet:
+    """A set from plain values (``to_dict`` plus ``mechanism``, or a parameter file's table);
+    ``record``: a run's record, kept as it ran (:func:`.files.from_dict`)."""
+    return _from_dict(data, get, record)
 
 
 def resolve(spec: str | Path | ParameterSet) -> ParameterSet:

@@ -70,13 +70,15 @@ def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> 
         raise ParameterError(f"{path}: {exc}") from None
 
 
-def from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+def from_dict(data: dict, registry_get: Callable[[str], ParameterSet], record: bool = False) -> ParameterSet:
     """A set from plain values, laid out as in a parameter file (``mechanism``, ``base``, the
-    fields, options in an ``options`` table or at the top level, as ``to_dict`` gives them)."""
-    return _from_dict(data, registry_get)
+    fields, options in an ``options`` table or at the top level, as ``to_dict`` gives them).
+    ``record``: the values are a record of a set that ran (a run's provenance), kept as they
+    are, where a file's edit of a value its options ignore is refused."""
+    return _from_dict(data, registry_get, record)
 
 
-def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
+def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet], record: bool = False) -> ParameterSet:
     data = dict(data)
     base_name = data.pop("base", None)
     options = data.pop("options", {})
@@ -121,6 +123,8 @@ def _from_dict(data: dict, registry_get: Callable[[str], ParameterSet]) -> Param
     data.setdefault("name", "custom")
     data.setdefault("source", "user parameter file")
     p = cls(**data, options=ModelOptions(**options))
+    if record:
+        return p
     try:
         named = registry_get(p.name)
     except ParameterError:  # a set of the user's own

@@ -85,8 +85,13 @@ class JointParameters(ParameterSet):
         """A copy with some parameters or options changed (validated); a new
         ``spring_length_upper_m`` is refused where ``spring_init = equilibrium`` ignores it."""
         new = super().replace(**changes)
-        if "spring_length_upper_m" in changes:
-            new.refuse_ignored_changes(self)
+        if "spring_length_upper_m" in changes or "spring_init" in changes:
+            # against the named set whose name the copy keeps: a length a given start used, taken
+            # back to equilibrium, is ignored too, and would be refused read back from its file
+            from . import REGISTRY, get
+
+            named = "name" not in changes and new.name in REGISTRY and type(get(new.name)) is type(new)
+            new.refuse_ignored_changes(get(new.name) if named else self)
         return new
 
     def refuse_ignored_changes(self, before: "JointParameters") -> None:
