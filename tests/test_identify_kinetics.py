@@ -177,3 +177,22 @@ def test_a_curve_fitted_and_validated_or_fitted_twice_is_refused(real_curves):
     for args in ([str(path), "--validate", str(path)], [str(path), other]):
         r = CliRunner().invoke(app, ["kinetics", *[c.path for c in real_curves[:3]], *args, "--no-progress"])
         assert r.exit_code == 2 and "given twice" in r.stderr, r.stderr
+
+
+def test_a_closed_stdout_does_not_cost_the_fit(real_curves, tmp_path):
+    """`identify kinetics ... --out fit.toml | head -1`: the fit's lines were printed before its
+    files were written, so a closed pipe lost them (found by review); now they are written first."""
+    import os
+    import subprocess
+    import sys
+
+    code = "import sys; sys.argv[0] = 'smafinger'; from smafinger.cli import _console; _console()"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    out, rep = tmp_path / "fit.toml", tmp_path / "fit.json"
+    p = subprocess.Popen([sys.executable, "-c", code, "identify", "kinetics", *[str(c.path) for c in real_curves[:2]],
+                          "--no-loo", "--out", str(out), "--report", str(rep), "--no-progress"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    p.stdout.close()  # the reader went away before the first line
+    err = p.stderr.read().decode()
+    assert (p.wait(), err) == (141, "")
+    assert out.stat().st_size > 0 and rep.stat().st_size > 0

@@ -152,12 +152,12 @@ def tune(
            "objective": res.objective, "evaluations": res.evaluations, "max_peak_T_C": res.max_peak_T_C,
            "scores": res.scores, "reference": res.reference, "history": res.history,
            "command": "smafinger tune " + " ".join(sys.argv[2:] if len(sys.argv) > 2 else [controller])}
+    if out is not None:  # before anything is printed: a closed stdout must not lose the gains
+        from ..files import atomic_write_text
+
+        atomic_write_text(out, json.dumps(doc, indent=2, default=float) + "\n")
     for t, s, r in zip(tasks, res.scores, res.reference):
         print(f"{t.name}: {task_measure(t, s):.4g} (paper's PID {task_measure(t, r):.4g}), "
               f"peak {s['peak_T_C']:.1f} degC (limit {res.max_peak_T_C:.1f}), "
               f"{s['interlock_violations']} interlock violations")
     print("values: " + ", ".join(f"{k}={v:.6g}" for k, v in res.values.items()))
-    if out is not None:
-        from ..files import atomic_write_text
-
-        atomic_write_text(out, json.dumps(doc, indent=2, default=float) + "\n")

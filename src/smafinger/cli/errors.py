@@ -66,6 +66,19 @@ def first_line(exc: BaseException | str) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def _stdout_gone() -> bool:
+    """Whether the standard output is a pipe whose reader has closed it (POLLERR on its write
+    end), so that a BrokenPipeError is ``| head`` having read enough, not another pipe breaking."""
+    import select
+
+    try:
+        poller = select.poll()
+        poller.register(sys.stdout.fileno(), select.POLLOUT)
+        return any(events & select.POLLERR for _, events in poller.poll(0))
+    except (OSError, ValueError, AttributeError):  # no file descriptor (captured), or no poll
+        return False
+
+
 def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
     """(exit status, the one line to print) for an exception escaping a command."""
     from ..engine.pools import BatchError
@@ -83,7 +96,7 @@ def classify(exc: BaseException, interrupted: str = "") -> tuple[int, str]:
         return EXIT_FAILED, f"smafinger: failed: {first_line(exc)}"
     if isinstance(exc, MemoryError):
         return EXIT_FAILED, "smafinger: out of memory: the run or its outputs do not fit; record less often or less time"
-    if isinstance(exc, BrokenPipeError) and exc.filename is None:  # the reader of stdout went away
+    if isinstance(exc, BrokenPipeError) and exc.filename is None and _stdout_gone():  # its reader went away
         return EXIT_BROKEN_PIPE, ""
     if isinstance(exc, OSError):
         where = f"{exc.filename}: " if exc.filename else ""

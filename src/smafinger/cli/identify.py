@@ -56,16 +56,12 @@ def _base(params: str, overrides: list[str] | None):
 
 
 def _finish(ident, targets) -> None:
-    """Print the fit, its warnings, then write every output together."""
+    """Write every output together, then print the fit and its warnings (in that order: a closed
+    standard output, ``| head``, must not cost the fit's files)."""
     import sys
 
     from ..files import Outputs, json_text
 
-    for line in ident.lines:
-        typer.echo(line)
-    sys.stdout.flush()
-    for w in ident.warnings:
-        typer.echo(f"smafinger: warning: {w}", err=True)
     outputs = Outputs()
     for path, what in targets:
         if what == "--out":
@@ -77,7 +73,13 @@ def _finish(ident, targets) -> None:
             outputs.add(path, lambda tmp, fig=fig, fmt=fmt: fig.savefig(tmp, dpi=110, format=fmt), what)
             continue
         outputs.add(path, lambda tmp, text=text: Path(tmp).write_text(text), what)
-    for path in outputs.commit():
+    written = outputs.commit()
+    for line in ident.lines:
+        typer.echo(line)
+    sys.stdout.flush()
+    for w in ident.warnings:
+        typer.echo(f"smafinger: warning: {w}", err=True)
+    for path in written:
         typer.echo(f"wrote {path}")
 
 

@@ -82,8 +82,8 @@ def actuator(
     except (FitError, SimulationError, BatchError) as exc:
         _fail(str(exc), 1)
     outputs, rep = _outputs(setup, result, time.perf_counter() - t0)
+    _commit(outputs, plot)  # before anything is printed: a closed stdout must not lose the fit
     _print(setup, result)
-    _commit(outputs, plot)
     for path in (out, report):
         if path is not None:
             typer.echo(f"wrote {path}")
