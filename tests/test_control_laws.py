@@ -4,7 +4,11 @@ import numpy as np
 import pytest
 
 from smafinger import simulate
-from smafinger.control.params import SlidingModeParameters
+from dataclasses import dataclass
+from typing import ClassVar
+
+from smafinger.control.params import FuzzyPIDParameters, RapidHeatingParameters, SlidingModeParameters
+from smafinger.control.sensing import Sensors
 from smafinger.parameters import get
 
 CYCLE = ("cooperative", "0:-25,reach:-55,reach:-40")
@@ -29,24 +33,31 @@ def test_sliding_mode_anti_windup_freezes_the_integral_at_its_own_gain(K_pct):
     assert np.max(free.duty_upper) == pytest.approx(K_pct) and np.max(clamped.duty_upper) == pytest.approx(K_pct)
 
 
+@dataclass(frozen=True, kw_only=True)
+class BlindRapidHeating(RapidHeatingParameters):
+    """Rapid heating reading the angle it does not declare (module level: the interpreted engine
+    pickles the run to its child process)."""
+
+    sensors: ClassVar[Sensors] = Sensors(position=False, temperature=True)
+
+
+@dataclass(frozen=True, kw_only=True)
+class BlindFuzzy(FuzzyPIDParameters):
+    sensors: ClassVar[Sensors] = Sensors(position=False, temperature=True)
+
+
 def test_a_controller_that_reads_an_undeclared_sensor_stops_the_run_at_once():
     """Its NaN duty left the wire off to the end without a word (found by review; the sensing
-    module's docstring promised the stop). Rapid heating reading the angle it did not declare:"""
-    from dataclasses import dataclass
-    from typing import ClassVar
-
-    from smafinger.control.params import RapidHeatingParameters
-    from smafinger.control.sensing import Sensors
+    module's docstring promised the stop)."""
     from smafinger.engine.run import DutyNotANumber
 
-    @dataclass(frozen=True, kw_only=True)
-    class Blind(RapidHeatingParameters):
-        sensors: ClassVar[Sensors] = Sensors(position=False, temperature=True)
-
     with pytest.raises(DutyNotANumber, match=r"not a number at t = 0 s \(controller 'rapid-heating'"):
-        simulate("paper2010", "independent", "0:-25", t_end_s=1.0, controller=Blind())
+        simulate("paper2010", "independent", "0:-25", t_end_s=1.0, controller=BlindRapidHeating())
     assert simulate("paper2010", "independent", "0:-25", t_end_s=1.0,
                     controller=RapidHeatingParameters()).metrics  # seeing, it runs
+    for engine in ("compiled", "interpreted"):  # plain Python divided by the rules' zero weight
+        with pytest.raises(DutyNotANumber, match=r"not a number at t = 0 s \(controller 'fuzzy-pid'"):
+            simulate("paper2010", "independent", "0:-25", t_end_s=0.01, controller=BlindFuzzy(), engine=engine)
 
 
 @pytest.mark.parametrize("change, needle", [

@@ -24,6 +24,7 @@ raise K_D and alpha (brake, integrate gently). The scheduled PID output is distr
 wires by the paper's phase selection (Sec. 2.6).
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -95,6 +96,8 @@ def scheduled_gains(ctrl, e, de):
             kd += mu * (1.0 - small if _KD_BIG[i, j] else small)
             alpha += mu * _ALPHA[i, j]
             w_sum += mu
+    if w_sum == 0.0:  # no rule fires (a NaN error): NaN gains, as compiled code's 0/0, in plain Python too
+        return Gains(math.nan, math.nan, math.nan)
     kp /= w_sum
     kd /= w_sum
     alpha /= w_sum

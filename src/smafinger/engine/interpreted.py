@@ -173,9 +173,12 @@ def _blow_up(spec, exc: ArithmeticError | ValueError):
         if tb.tb_frame.f_code.co_name == "run_kernel":
             frame = tb.tb_frame
         tb = tb.tb_next
-    if frame is None or "a" not in frame.f_locals:
+    if frame is None:
         return None
-    t_s = frame.f_locals["a"] * frame.f_locals["run"].tick_s
+    ticks = frame.f_locals.get("a", frame.f_locals.get("t"))  # a sub-step's start, or its tick's
+    if ticks is None:
+        return None
+    t_s = ticks * frame.f_locals["run"].tick_s
     return SimulationError(f"numerical blow-up at t = {t_s:.9g} s ({type(exc).__name__}: {exc}, in the sub-step "
                            f"from there): {describe_state(spec.params, frame.f_locals['y'])}")
 
