@@ -38,6 +38,6 @@ def test_a_scenario_name_always_means_the_same_definition():
     changed = sorted(n for n in record if n in now and now[n] != record[n])
     gone = sorted(set(record) - set(now))
     new = {n: h for n, h in now.items() if n not in record}
-    assert not changed, f"these scenarios changed their definition under the same name; give them a new version: {changed}"
+    assert not changed, f"these scenarios changed their definition under one name; give them a new version: {changed}"
     assert not gone, f"recorded scenarios that no longer exist: {gone}"
     assert not new, f"new scenarios: add them to tests/golden/scenario_definitions.json: {json.dumps(new)}"

@@ -272,8 +272,8 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     report.md into ``out_dir``.
 
     ``only``: scenario names or glob patterns (default: all). ``investigate``: run the Fig. 15
-    readings (default: when both on-reach Fig. 15 scenarios are selected). ``progress``: a
-    flag or a :class:`~smafinger.progress.Display`.
+    readings and studies (default: when every scenario they read is selected,
+    :func:`check_investigate`). ``progress``: a flag or a :class:`~smafinger.progress.Display`.
 
     All or nothing: the outputs are written into a hidden folder inside ``out_dir``
     (:data:`STAGE_PREFIX`) and moved into place at the end, after what an earlier reproduce
@@ -355,4 +355,5 @@ def _publish(stage: Path, out_dir: Path) -> None:
             signal.signal(signal.SIGINT, previous)
 
 
-__all__ = ["reproduce", "check_out_dir", "own_files", "STAGE_PREFIX", "run_tasks", "select", "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
+__all__ = ["reproduce", "check_out_dir", "check_investigate", "own_files", "STAGE_PREFIX", "run_tasks", "select",
+           "json_ready", "ReproduceOutput", "Run", "EVERY", "JSON_DIGITS"]
