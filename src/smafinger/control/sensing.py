@@ -5,7 +5,7 @@ resistance (the voltage across it over the current through it), so every control
 it (:mod:`smafinger.model.resistance`, phase and temperature dependent). That includes the ticks
 at which a wire is off (0 % duty, or V_L = 0 between pulses): the bench assumes a board that
 passes a small sensing current through every wire, as self-sensing boards do, and neglects that
-current's heating (10 mA in the paper's 3.4 ohm wire: 0.3 mW, against 19 W at 8 V). The
+current's heating (10 mA in the paper's 3.3 ohm wire: 0.3 mW, against 19 W at 8 V). The
 coordinate and its rate (an angle encoder or a position sensor) and the wire temperatures (a
 thermocouple or similar on each wire) are NaN unless declared: a controller that closes the
 loop on resistance alone cannot read the angle by mistake, and the NaN duty that follows stops
