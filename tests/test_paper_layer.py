@@ -337,3 +337,16 @@ def test_a_claim_whose_run_failed_is_not_reported_as_not_selected():
     assert f"1 claim(s) not evaluated because a run failed: {claim.figure}" in text
     assert f"({claim.scenarios[0]} failed)" in text
     assert "1 claim(s) not run (their scenarios were not selected)" in text
+
+
+def test_the_report_says_which_investigation_runs_failed():
+    """A failed run's cells read 'never' in the study tables, like a run that did not finish:
+    the report now says which failed above them (found by review)."""
+    from types import SimpleNamespace
+
+    from smafinger.paper.report import failed_runs_note
+
+    runs = {"a": SimpleNamespace(ok=True), "cycle:tamb60:fig15-independent-v2": SimpleNamespace(ok=False)}
+    note = "\n".join(failed_runs_note(runs))
+    assert note.startswith("**1 run(s) failed: cycle:tamb60:fig15-independent-v2.**") and "`never`" in note
+    assert failed_runs_note({"a": SimpleNamespace(ok=True)}) == []

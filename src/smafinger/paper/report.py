@@ -142,6 +142,17 @@ def runs_section(runs: dict[str, Run], figures: list[Path]) -> list[str]:
     return lines + [""]
 
 
+def failed_runs_note(runs: dict[str, Run]) -> list[str]:
+    """A line naming the failed runs, above the study tables, where a failed run's cells read
+    ``never`` as a run that did not finish would (found by review); none if every run finished."""
+    failed = [k for k, r in runs.items() if not r.ok]
+    if not failed:
+        return []
+    return [f"**{len(failed)} run(s) failed: {', '.join(failed)}.** In the tables below a failed run's cells "
+            "read `never`, as a run that did not finish in its time would; the findings drawn from them do "
+            "not hold.", ""]
+
+
 def write_report(path: Path, outcomes: list[Outcome], rows: list[dict] | None, runs: dict[str, Run],
                  figures: list[Path], wall_s: float, workers: int, tables: dict | None = None) -> None:
     """Write ``report.md`` (atomically); ``tables``: the studies' (:func:`.issue10.study_tables`)."""
@@ -151,6 +162,8 @@ def write_report(path: Path, outcomes: list[Outcome], rows: list[dict] | None, r
              + (f" and {len(runs) - n_sc} investigation runs" if len(runs) > n_sc else "")
              + f" on {workers} worker process(es), {wall_s:.1f} s in all.", ""]
     lines += readings() + claims_table(outcomes)
+    if tables or rows:
+        lines += failed_runs_note(runs)
     if tables and tables["hysteresis"]:
         lines += hysteresis_section(tables["hysteresis"])
     if tables and tables["cycles"]:
@@ -162,4 +175,4 @@ def write_report(path: Path, outcomes: list[Outcome], rows: list[dict] | None, r
     atomic_write(path, lambda tmp: Path(tmp).write_text(text))
 
 
-__all__ = ["write_report", "readings", "claims_table", "investigation_section", "runs_section"]
+__all__ = ["write_report", "failed_runs_note", "readings", "claims_table", "investigation_section", "runs_section"]
