@@ -278,6 +278,11 @@ def test_p4_return_point_memory(case, data):
     u = np.array(data.draw(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=30)))
     u = np.minimum(u, 1.0 - 1e-9)  # strictly before the previous reversal point
     E = np.concatenate([T[k] + u * (far - T[k]), [T[k]]])  # wander back, return to sample k
+    # a turn whose tau rounds to sample k's is a loop of zero width: dropped at birth, its branch
+    # re-anchored at the point (docs/hysteresis.md), so equal to rounding only (the next test;
+    # CI's random search found one: 2 ulps of T below 105.17 degC, the same tau at 171 MPa)
+    c = m.c_M_Pa_per_C if d > 0 else m.c_A_Pa_per_C
+    assume(np.all((E[:-1] - sigma[k] / c) != (T[k] - sigma[k] / c)))
     T2 = np.concatenate([T[:k + 1], E, T[k + 1:]])
     S2 = np.concatenate([sigma[:k + 1], np.full(E.size, sigma[k]), sigma[k + 1:]])
     base = xi_history(T, sigma, m, xi_init=xi0).xi
@@ -285,6 +290,24 @@ def test_p4_return_point_memory(case, data):
     # after the excursion the history continues as if it had not happened, to the bit
     assert np.array_equal(with_excursion[k + 1 + E.size:], base[k + 1:])
     assert np.array_equal(with_excursion[:k + 1], base[:k + 1])
+
+
+def test_p4_a_loop_of_zero_width_rejoins_to_rounding():
+    """Heating at 171 MPa, a turn about one ulp of T back whose tau rounds to the same value,
+    then on: the loop is dropped at birth and its branch re-anchored at the point, so the
+    continuation equals the history without it to rounding (the case CI's random search of the
+    test above found)."""
+    sigma, T_k, T_back = 171284036.6687411, 105.17046332405262, 105.1704633240526
+    c = PAPER.c_M_Pa_per_C
+    assert T_back < T_k and T_back - sigma / c == T_k - sigma / c  # a loop of zero width in tau
+    T = np.concatenate([np.linspace(70.0, T_k, 36), np.linspace(T_k, 127.0, 22)[1:]])
+    k = 35
+    T2 = np.concatenate([T[:k + 1], [T_back, T_k], T[k + 1:]])
+    base = xi_history(T, np.full(T.size, sigma), PAPER, xi_init=1.0).xi
+    with_turn = xi_history(T2, np.full(T2.size, sigma), PAPER, xi_init=1.0).xi
+    assert np.ptp(base[k + 1:]) > 0.1  # transforming after the turn
+    assert np.array_equal(with_turn[:k + 1], base[:k + 1])
+    assert np.max(np.abs(with_turn[k + 3:] - base[k + 1:])) <= 4 * np.finfo(float).eps
 
 
 def test_p4_exact_when_the_excursion_starts_at_a_reversal():
