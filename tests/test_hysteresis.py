@@ -281,7 +281,7 @@ def test_p4_return_point_memory(case, data):
     # a turn whose tau rounds to sample k's is a loop of zero width: dropped at birth, its branch
     # re-anchored at the point (docs/hysteresis.md), so equal to rounding only (the next test;
     # CI's random search found one: 2 ulps of T below 105.17 degC, the same tau at 171 MPa)
-    c = m.c_M_Pa_per_C if d > 0 else m.c_A_Pa_per_C
+    c = m.c_A_Pa_per_C if d > 0 else m.c_M_Pa_per_C  # the tau the branch back to sample k is aimed in
     assume(np.all((E[:-1] - sigma[k] / c) != (T[k] - sigma[k] / c)))
     T2 = np.concatenate([T[:k + 1], E, T[k + 1:]])
     S2 = np.concatenate([sigma[:k + 1], np.full(E.size, sigma[k]), sigma[k + 1:]])
@@ -298,7 +298,7 @@ def test_p4_a_loop_of_zero_width_rejoins_to_rounding():
     continuation equals the history without it to rounding (the case CI's random search of the
     test above found)."""
     sigma, T_k, T_back = 171284036.6687411, 105.17046332405262, 105.1704633240526
-    c = PAPER.c_M_Pa_per_C
+    c = PAPER.c_A_Pa_per_C
     assert T_back < T_k and T_back - sigma / c == T_k - sigma / c  # a loop of zero width in tau
     T = np.concatenate([np.linspace(70.0, T_k, 36), np.linspace(T_k, 127.0, 22)[1:]])
     k = 35
