@@ -189,3 +189,43 @@ def test_the_current_folder_and_a_symlink_can_take_a_reproduce(tmp_path, capsys,
     assert main(argv + [str(tmp_path / "link")]) == 0 and main(argv + [str(tmp_path / "link")]) == 0
     assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "summary.json").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["here", "link", "real"]
+
+
+def test_a_failure_while_moving_the_outputs_in_puts_the_earlier_ones_back(tmp_path, capsys, monkeypatch):
+    """Found by review: a runs/ the process could not write left --out without its summary,
+    report and figures, the new outputs stranded in the hidden folder."""
+    from pathlib import Path
+
+    out = tmp_path / "out"
+    argv = ["reproduce", "--out", str(out), "--only", QUICK[0], "--workers", "1", "--no-progress"]
+    assert main(argv) == 0
+    before = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    real = Path.rename
+
+    def fails_in_runs(self, target):
+        if Path(target).parent == out / "runs" and ".partial-" in str(self) and ".old" not in str(self):
+            raise PermissionError(13, "Permission denied (simulated)", str(target))
+        return real(self, target)
+
+    monkeypatch.setattr(Path, "rename", fails_in_runs)
+    assert main(argv) == 1
+    assert "the outputs could not be moved into place" in capsys.readouterr().err
+    monkeypatch.setattr(Path, "rename", real)
+    after = {p.relative_to(out): p.read_bytes() for p in out.rglob("*") if p.is_file()}
+    assert after == before and sorted(p.name for p in out.iterdir()) == sorted(
+        p.name for p in out.iterdir() if not p.name.startswith("."))  # no hidden folder left
+
+
+def test_ctrl_c_after_the_outputs_are_in_place_says_so(tmp_path, capsys, monkeypatch):
+    import importlib
+
+    cli_reproduce = importlib.import_module("smafinger.cli.reproduce")
+
+    def interrupted(res):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli_reproduce, "_print", interrupted)
+    out = tmp_path / "out"
+    assert main(["reproduce", "--out", str(out), "--only", QUICK[0], "--workers", "1", "--no-progress"]) == 130
+    assert f"interrupted (Ctrl-C) after the outputs were written to {out}" in capsys.readouterr().err
+    assert (out / "summary.json").exists()

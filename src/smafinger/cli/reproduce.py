@@ -38,7 +38,10 @@ def reproduce(
     check_out_dir(out)  # before any run: a file, a missing parent, a folder holding other files
     with progress_display(progress) as display:
         res = run(out, only=only, workers=workers, progress=display, investigate=investigate)
-    _print(res)
+    try:
+        _print(res)
+    except KeyboardInterrupt:  # the outputs are in place: not "no output was written"
+        raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
     if res.failed:
         raise WorkFailed(f"{len(res.failed)} run(s) failed: {', '.join(res.failed)} (see summary.json)")
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import fnmatch
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable
@@ -314,7 +315,9 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
         outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
         wall = time.perf_counter() - t0
         write_report(stage / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
-        check_out_dir(out_dir)  # still only what a reproduce writes
+        with _sigint_held():  # from the last check to the last rename: all the old, or all the new
+            check_out_dir(out_dir)  # still only what a reproduce writes
+            _publish(stage, out_dir)
     except BaseException as exc:
         shutil.rmtree(stage, ignore_errors=True)
         if made:
@@ -325,34 +328,64 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
         if isinstance(exc, BatchError):  # a worker died: nothing is kept
             raise BatchError(f"{exc}; no output was written ({out_dir} is as it was)") from None
         raise
-    _publish(stage, out_dir)
     figures = [out_dir / p.relative_to(stage) for p in figures]
     return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
 
 
-def _publish(stage: Path, out_dir: Path) -> None:
-    """Replace what an earlier reproduce wrote in ``out_dir`` by ``stage``'s files: the old ones
-    removed, the new renamed into place (within one folder: no copy), with Ctrl-C held off
-    meanwhile (a Ctrl-C then is let go: the outputs are complete)."""
+@contextmanager
+def _sigint_held():
+    """Ctrl-C ignored inside (in the main thread; elsewhere nothing to hold)."""
     import signal
     import threading
 
-    top, runs = own_files()
     held = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if held else None
     try:
-        for p in [out_dir / n for n in top] + [out_dir / "runs" / n for n in runs]:
-            p.unlink(missing_ok=True)
-        (out_dir / "runs").mkdir(exist_ok=True)
-        for p in (stage / "runs").iterdir():
-            p.rename(out_dir / "runs" / p.name)
-        (stage / "runs").rmdir()
-        for p in stage.iterdir():
-            p.rename(out_dir / p.name)
-        stage.rmdir()
+        yield
     finally:
         if held and previous is not None:
             signal.signal(signal.SIGINT, previous)
+
+
+def _publish(stage: Path, out_dir: Path) -> None:
+    """Replace what an earlier reproduce wrote in ``out_dir`` by ``stage``'s files, by renames
+    within ``out_dir`` (no copy): the old ones moved into ``stage/.old``, the new ones moved in,
+    then ``stage`` removed. An OSError on the way moves everything back (``out_dir`` as it was)
+    and is raised naming the file (found by review: a ``runs/`` not writable left the folder
+    without its summary and report)."""
+    import shutil
+
+    top, runs = own_files()
+    old = stage / ".old"
+    (old / "runs").mkdir(parents=True)
+    moved: list[tuple[Path, Path]] = []  # (from, to), in order
+
+    def move(src: Path, dst: Path) -> None:
+        src.rename(dst)
+        moved.append((src, dst))
+
+    try:
+        for name in top:
+            if (out_dir / name).exists():
+                move(out_dir / name, old / name)
+        for name in runs:
+            if (out_dir / "runs" / name).exists():
+                move(out_dir / "runs" / name, old / "runs" / name)
+        (out_dir / "runs").mkdir(exist_ok=True)
+        for p in sorted((stage / "runs").iterdir()):
+            move(p, out_dir / "runs" / p.name)
+        for p in sorted(stage.iterdir()):
+            if p.name not in (".old", "runs"):
+                move(p, out_dir / p.name)
+    except OSError as exc:
+        for src, dst in reversed(moved):
+            try:
+                dst.rename(src)
+            except OSError:
+                pass
+        raise OSError(f"--out {out_dir}: the outputs could not be moved into place ({exc}); the earlier "
+                      f"outputs were put back") from None
+    shutil.rmtree(stage, ignore_errors=True)
 
 
 __all__ = ["reproduce", "check_out_dir", "check_investigate", "own_files", "STAGE_PREFIX", "run_tasks", "select",
