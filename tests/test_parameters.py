@@ -187,17 +187,21 @@ def test_an_option_given_twice_in_a_file_is_refused(tmp_path, base):
         resolve(str(f))
 
 
-def test_a_given_length_taken_back_to_equilibrium_is_refused_and_a_record_is_kept(tmp_path):
+def test_a_given_length_taken_back_to_equilibrium_is_the_named_sets_and_a_record_is_kept(tmp_path):
     """Found by review: a given start with its own length, set back to equilibrium under the named
-    set's name, was written by `params --out` and then refused when read back; and a run's record
-    of such a set (made before the refusal existed) no longer replayed."""
+    set's name, was written by `params --out` and then refused when read back; refusing it instead
+    broke a sweep over spring_init. The length equilibrium ignores now takes the named set's value,
+    and a run's record (made before the refusal existed) replays as it ran."""
     from smafinger.parameters import from_dict
 
     p = get("paper2010")
     given = p.replace(spring_init="given", spring_length_upper_m=0.0176)
+    back = given.replace(spring_init="equilibrium")
+    assert back == p and back.spring_length_upper_m == p.spring_length_upper_m
+    back.save(tmp_path / "b.toml")
+    assert load_toml(tmp_path / "b.toml", get) == p  # reads back
     with pytest.raises(ParameterError, match="spring_length_upper_m = 0.0176 has no effect .* paper2010 has"):
-        given.replace(spring_init="equilibrium")
-    assert given.replace(spring_init="equilibrium", spring_length_upper_m=p.spring_length_upper_m) == p
+        given.replace(spring_init="equilibrium", spring_length_upper_m=0.0176)  # asked for: refused
     ran = {"mechanism": "joint", **p.to_dict()}
     ran["spring_length_upper_m"] = 0.0176
     assert from_dict(ran, record=True).spring_length_upper_m == 0.0176  # as it ran: kept

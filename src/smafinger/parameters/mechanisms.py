@@ -83,15 +83,22 @@ class JointParameters(ParameterSet):
 
     def replace(self, **changes):
         """A copy with some parameters or options changed (validated); a new
-        ``spring_length_upper_m`` is refused where ``spring_init = equilibrium`` ignores it."""
-        new = super().replace(**changes)
-        if "spring_length_upper_m" in changes or "spring_init" in changes:
-            # against the named set whose name the copy keeps: a length a given start used, taken
-            # back to equilibrium, is ignored too, and would be refused read back from its file
-            from . import REGISTRY, get
+        ``spring_length_upper_m`` is refused where ``spring_init = equilibrium`` ignores it.
 
-            named = "name" not in changes and new.name in REGISTRY and type(get(new.name)) is type(new)
-            new.refuse_ignored_changes(get(new.name) if named else self)
+        Set back to equilibrium alone (a given start's own length left as it was), the length
+        it now ignores takes the value of the named set whose name the copy keeps: the set is
+        the one its file reads back as (a file's edit of it is refused), and a sweep over
+        ``spring_init`` runs (found by review)."""
+        new = super().replace(**changes)
+        if "spring_length_upper_m" not in changes and "spring_init" not in changes:
+            return new
+        from . import REGISTRY, get
+
+        named = get(new.name) if ("name" not in changes and new.name in REGISTRY) else None
+        reference = named if type(named) is type(new) else self
+        if "spring_length_upper_m" not in changes and new.spring_init == SpringInit.EQUILIBRIUM:
+            return super(JointParameters, new).replace(spring_length_upper_m=reference.spring_length_upper_m)
+        new.refuse_ignored_changes(reference)
         return new
 
     def refuse_ignored_changes(self, before: "JointParameters") -> None:
