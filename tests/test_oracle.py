@@ -15,7 +15,6 @@ import sys
 from functools import partial
 
 import oracle
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from oracle import Affine, Held, Kinetics, MemoryBranch, Phase, Vars, WireHeld, WireVars
