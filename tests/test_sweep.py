@@ -799,7 +799,7 @@ def test_a_broken_pool_says_the_finished_runs_are_saved_and_resumable(tmp_path, 
             yield res
 
     monkeypatch.setattr(pools.SerialPool, "map_tasks", breaks_after_one)
-    with pytest.raises(pools.BatchError, match=r"a worker process died \(killed\); after 1 of 4 runs, finished runs "
+    with pytest.raises(pools.BatchError, match=r"a worker process died \(killed\); after 1 of 4 runs; finished runs "
                                                r"are saved in .* - run the same sweep again to resume"):
         run_sweep(spec, tmp_path / "t.parquet", workers=1)
     monkeypatch.setattr(pools.SerialPool, "map_tasks", real)

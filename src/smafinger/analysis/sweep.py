@@ -68,12 +68,17 @@ PART_MAX_ROWS = 4096
 CHECK_HERE_MAX = 2000
 
 
+def kept_runs(done: int, total: int, parts: Path) -> str:
+    """What a sweep stopped part-way keeps, and how to go on (after Ctrl-C or a broken pool)."""
+    return (f"after {done} of {total} runs; finished runs are saved in {parts} - run the same sweep again "
+            "to resume")
+
+
 class SweepInterrupted(KeyboardInterrupt):
     """The sweep was interrupted; what finished is saved (run it again to resume)."""
 
     def __init__(self, done: int, total: int, parts: Path):
-        super().__init__(f"interrupted after {done} of {total} runs; finished runs are saved in "
-                         f"{parts} - run the same sweep again to resume")
+        super().__init__(f"interrupted {kept_runs(done, total, parts)}")
         self.done, self.total, self.parts = done, total, parts
 
 
@@ -296,8 +301,7 @@ def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tu
     except batch.BatchError as exc:  # the pool broke: what finished is saved, as after Ctrl-C
         say.stop()
         saver.flush()
-        raise batch.BatchError(f"{exc}; after {done} of {total} runs, finished runs are saved in {saver.pdir} - run "
-                         "the same sweep again to resume") from None
+        raise batch.BatchError(f"{exc}; {kept_runs(done, total, saver.pdir)}") from None
     except BaseException:
         say.stop()
         saver.flush()
