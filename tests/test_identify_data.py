@@ -152,6 +152,25 @@ def test_angle_missing_columns_and_too_few_points(tmp_path):
     assert "empty file" in error_of(load_angle_curve, write(tmp_path / "e.csv", [""]))
 
 
+@pytest.mark.parametrize("header, extra, expected", [
+    ("time_s,angle_deg,supply_V", "", "line 1: column 'supply_V' is not one a curve may have (time: time, t;"),
+    ("time_s,angle_deg,voltage,V", ",5", "line 1: column 'V' is a second voltage column (after 'voltage')"),
+    ("time [s],angle [deg]", "", "row 1 (line 2): a value in column 3, which the header does not name"),
+    ("time [s],angle [deg],", "", "row 1 (line 2): a value in column 3, which the header does not name"),
+])
+def test_a_column_the_reader_does_not_know_is_refused(tmp_path, header, extra, expected):
+    """An unknown column was skipped: a voltage column under another name (or under no name,
+    the header one column short) was dropped, and the curve fitted at the default 8 V."""
+    rows = [header] + [f"{0.1 * i:.2f},{-40 + i:.1f},5{extra}" for i in range(30)]
+    assert expected in error_of(load_angle_curve, write(tmp_path / "x.csv", rows))
+
+
+def test_a_trailing_comma_and_volts_are_read(tmp_path):
+    rows = ["time,angle,volts,"] + [f"{0.1 * i:.2f},{-40 + i:.1f},5," for i in range(30)]
+    c = load_angle_curve(write(tmp_path / "ok.csv", rows))
+    assert c.voltage_V is not None and np.all(c.voltage_V == 5.0) and c.t_s.size == 30
+
+
 # ---- CLI: one line on stderr, exit 2, nothing written ----------------------------------------
 def _outputs(tmp_path):
     return [str(tmp_path / "fit.toml"), str(tmp_path / "fit.json"), str(tmp_path / "fit.png")]

@@ -12,7 +12,10 @@ Two kinds of file:
   Recognised names (case-insensitive, a unit in brackets or after ``_``): ``time``/``t``,
   ``angle``/``theta``, ``voltage``/``v``/``v_upper``. A unit given must be the one the column
   is read in (s, deg, V; :data:`UNITS`): ``angle_rad`` or ``time [ms]`` is refused, not read
-  as degrees or seconds.
+  as degrees or seconds. Any other column, a second column for the same quantity and a value
+  in a column the header does not name are refused too (a voltage column under another name
+  was dropped, and the curve fitted at the default voltage); a column without a name (a
+  trailing comma) may stay if it holds no values.
 
 Any problem raises :class:`DataError` with one line naming the file, the row and the problem.
 "Row N" counts data rows from 1; the file's line number is given too.
@@ -230,7 +233,7 @@ class AngleCurve:
 _ALIASES = {
     "time": ("time", "t"),
     "angle": ("angle", "theta", "phi"),
-    "voltage": ("voltage", "v", "v_upper", "voltage_upper", "u"),
+    "voltage": ("voltage", "v", "v_upper", "voltage_upper", "u", "volt", "volts"),
 }
 _UNIT_SUFFIX = re.compile(r"(\[.*\]|\(.*\)|_(s|sec|deg|degrees|v|volt|volts|rad)$)")
 #: the units each column is read in, as a header may write them (lower case)
@@ -267,21 +270,33 @@ def load_angle_curve(path: str | Path) -> AngleCurve:
         raise DataError(f"{path}: empty file (expected a CSV header with columns time [s], angle [deg])")
     head_ln, head_text = numbered[0]
     header = next(csv.reader([head_text]))
+    found = ", ".join(repr(h.strip()) for h in header)
+    if all(_is_number(h) for h in header):
+        raise DataError(f"{_where(path, line=head_ln)}: no time column [s] in the header (found: {found}) "
+                        f"(the first line must be a header)")
+    names = "; ".join(f"{c}: {', '.join(n)}" for c, n in _ALIASES.items())
     cols: dict[str, int] = {}
     for j, name in enumerate(header):
+        if not name.strip():
+            continue  # a column without a name (a trailing comma) must hold no values: checked by row
         c = _canonical(name)
-        if c is not None and c not in cols:
-            unit = _unit(name)
-            if unit is not None and unit not in UNITS[c]:
-                raise DataError(f"{_where(path, line=head_ln)}: column {name.strip()!r} is in {unit!r}, but the {c} is "
-                                f"read in {UNITS[c][0]}: convert the column to {UNITS[c][0]} and name it so")
-            cols[c] = j
-    found = ", ".join(repr(h.strip()) for h in header)
+        # an unknown column is refused, not skipped: a voltage under another name would be
+        # dropped and the curve fitted at the default voltage
+        if c is None:
+            raise DataError(f"{_where(path, line=head_ln)}: column {name.strip()!r} is not one a curve may have "
+                            f"({names}; a unit in brackets or after '_')")
+        if c in cols:
+            raise DataError(f"{_where(path, line=head_ln)}: column {name.strip()!r} is a second {c} column "
+                            f"(after {header[cols[c]].strip()!r})")
+        unit = _unit(name)
+        if unit is not None and unit not in UNITS[c]:
+            raise DataError(f"{_where(path, line=head_ln)}: column {name.strip()!r} is in {unit!r}, but the {c} is "
+                            f"read in {UNITS[c][0]}: convert the column to {UNITS[c][0]} and name it so")
+        cols[c] = j
     for need, unit in (("time", "s"), ("angle", "deg")):
         if need not in cols:
-            hint = " (the first line must be a header)" if all(_is_number(h) for h in header) else ""
             raise DataError(f"{_where(path, line=head_ln)}: no {need} column [{unit}] in the header "
-                            f"(found: {found}){hint}")
+                            f"(found: {found})")
     data = numbered[1:]
     n = len(data)
     t = np.empty(n)
@@ -291,6 +306,10 @@ def load_angle_curve(path: str | Path) -> AngleCurve:
     for i, (ln, text) in enumerate(data):
         row = i + 1
         fields = next(csv.reader([text]))
+        unnamed = [j + 1 for j, f in enumerate(fields) if f.strip() and (j >= len(header) or not header[j].strip())]
+        if unnamed:
+            raise DataError(f"{_where(path, row, ln)}: a value in column {unnamed[0]}, which the header does not name "
+                            f"(header: {found})")
         for c, arr, unit, rng in (("time", t, "s", None), ("angle", a, " deg", ANGLE_RANGE_DEG),
                                   ("voltage", v, " V", VOLTAGE_RANGE_V)):
             if arr is None:
