@@ -95,3 +95,12 @@ def test_tune_bad_input_is_one_line_exit_2(tmp_path, args, names):
     lines = [x for x in r.output.splitlines() if x.strip()]
     assert len(lines) == 1 and names in lines[0]
     assert not out.exists()
+
+
+def test_tune_out_in_a_missing_folder_is_refused_before_the_tuning(tmp_path):
+    """--out was checked only once CMA-ES had finished, and the tuning was lost."""
+    out = tmp_path / "nodir" / "t.json"
+    r = CliRunner().invoke(app, ["tune", "pid", "-t", "fig15-cycle", "--budget", "8", "--out", str(out)])
+    assert r.exit_code == 2, r.output
+    lines = [x for x in r.output.splitlines() if x.strip()]
+    assert len(lines) == 1 and f"--out {out}: folder" in lines[0], lines

@@ -137,6 +137,10 @@ def tune(
             _fail(f"{name} {v}: must be >= {lo}")
     if workers is not None and workers < 1:
         _fail(f"--workers {workers}: must be >= 1")
+    if out is not None:  # refused before the tuning, not after it
+        from ..files import check_output
+
+        check_output(out, "--out")
     tasks = _tasks([mechanism], task)
     try:
         free = [FreeParam.parse(x) for x in param] or None
