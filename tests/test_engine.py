@@ -83,6 +83,41 @@ def test_blow_up_reports_time_and_state():
         simulate(p, "open-loop", voltage="0:8:0", t_end_s=5.0, dt_s=1e-3)
 
 
+@pytest.mark.parametrize("method, pwm", [("rk4", "averaged"), ("authors-ode4", None)])
+def test_a_divergence_still_finite_is_a_blow_up(method, pwm):
+    """rk4 beyond its stability limit against the joint's damping (1.5 ms; no PWM edge shortens
+    the averaged PWM's steps) grows for a long time before it overflows: it returned joint angles
+    of -6e14 deg as a result, its only warnings blaming the springs (found by review)."""
+    with pytest.raises(SimulationError, match=r"blow-up at t = .*out of any physical range.*theta_rad="):
+        simulate("paper2010", "cooperative", "0:-55", t_end_s=3.0, method=method, dt_s=5e-3, pwm=pwm)
+
+
+def test_an_unstable_casing_node_is_a_blow_up():
+    """An explicit casing node with a small heat capacity swung to -2,412 degC, below absolute
+    zero, with no error and no warning (found by review)."""
+    p = get("paper2010").replace(thermal_model="two-node", casing_heat_capacity_J_mK=5.5e-4, h2_heating_W_m2K3=0.6)
+    with pytest.raises(SimulationError, match=r"blow-up at t = .*T_casing_lower_C="):
+        simulate(p, "independent", "0:-46", t_end_s=10.0, method="semi-implicit", dt_s=1e-3, pwm="exact")
+
+
+def test_a_stress_solve_that_fails_is_a_blow_up():
+    """Under the algebraic law the stress is solved, not a state: a NaN there left the state finite
+    and was recorded in 999 of 1,001 samples without an error (found by review; that case, the
+    slack penalty's cosh overflowing, now has a rigid spring, and the stop is kept for any other)."""
+    from smafinger.engine.substep import _aux_finite
+    from smafinger.model.records import Aux, WireAux, WireState
+
+    wa = WireAux(0.5, 1e8, 10.0, 0.0, 0.01, 0.0, WireState(0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    assert _aux_finite(Aux(0.1, (wa, wa)))
+    for bad in (Aux(math.nan, (wa, wa)), Aux(0.1, (wa, wa._replace(sigma_Pa=math.nan))),
+                Aux(0.1, (wa._replace(xi=math.inf), wa))):
+        assert not _aux_finite(bad)
+    p = get("paper2010").replace(wire_diameter_m=1e-5, slack_penalty_per_mm=100.0, stress_law="algebraic")
+    r = simulate(p, "cooperative", "0:-30", t_end_s=1.0)
+    for name in ("xi_upper", "sigma_upper_Pa", "load_Nm", "R_upper_ohm"):
+        assert np.all(np.isfinite(r.signal(name))), name
+
+
 @pytest.mark.parametrize("numerics", [{}, {"method": "rk4"}])  # the long-step default, the reference
 def test_interlock_counter_counts_a_forced_violation(numerics):
     spec = make_spec("paper2010", "open-loop", voltage="0:8:0", t_end_s=0.1, **numerics)

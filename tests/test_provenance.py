@@ -174,6 +174,39 @@ def test_thresholds_are_applied_at_their_values():
     assert peak_over < OVERHEAT_MARGIN_C and float(np.max(r.sigma_upper_Pa)) < STRESS_RATING_PA
 
 
+def test_values_no_wire_has_are_warned_of():
+    """xi outside [0, 1] and a wire in compression were returned without a word (found by review)."""
+    p = get("linear-bias-spring").replace(hysteresis="authors2020")
+    r = simulate(p, "cooperative", "0:0.0058", t_end_s=10.0, controller="sliding-mode", method="authors-ode4",
+                 dt_s=1e-3)
+    assert float(np.max(r.xi_wire)) > 1.2
+    assert any(w.startswith("wire wire: xi = 1.2") and "outside [0, 1]" in w and "do not clip" in w
+               for w in r.metrics["warnings"]), r.metrics["warnings"]
+    p = get("linear-bias-spring").replace(D_A_Pa=1e8)
+    r = simulate(p, "independent", "0:0.0266,reach:-0.0099", t_end_s=2.0, controller="fuzzy-pid", hold_s=1.0,
+                 tol_m=0.002, method="rk4", dt_s=1e-3, pwm="exact")
+    assert float(np.min(r.sigma_wire_Pa)) < -1e6
+    assert any("the wire pushes" in w for w in r.metrics["warnings"]), r.metrics["warnings"]
+
+
+def test_a_temperature_nothing_can_reach_is_warned_of_at_its_threshold():
+    from types import SimpleNamespace
+
+    from smafinger.plausibility import COLD_MARGIN_C, _impossible_wire
+
+    p = get("paper2010")  # no latent heat
+    t = np.linspace(0.0, 1.0, 5)
+    floor = min(p.T_amb_C, p.T_init_C) - COLD_MARGIN_C
+    for wire_min, casing_min, expected in ((floor + 0.01, floor + 0.01, 0), (floor - 0.01, floor + 0.01, 1),
+                                           (floor + 2.0, floor - 0.01, 1), (floor - 0.01, floor - 2.0, 2)):
+        T = np.array([p.T_init_C, 60.0, wire_min, 40.0, 30.0])
+        casing = np.array([p.T_amb_C, 25.0, casing_min, 23.0, 22.5])
+        result = SimpleNamespace(column_names=["T_casing_upper_C"], signal=lambda name, c=casing: c)
+        out = _impossible_wire(result, p, "upper", np.zeros(5), np.zeros(5), T, t)
+        assert len(out) == expected, (wire_min, casing_min, out)
+        assert all("numerical instability" in w for w in out)
+
+
 def resolve_with(*overrides):
     return get("paper2010").with_overrides(list(overrides))
 

@@ -15,7 +15,13 @@ survives either. :func:`check` flags, per wire:
   deform plastically, which the model does not describe;
 - **a start outside the loop**: ``xi_init`` outside the major hysteresis loop at ``T_init_C``
   (say fully martensite at 100 degC): the kinetics place it on the loop at t = 0, so the run
-  starts from another xi than the set names.
+  starts from another xi than the set names;
+- **no such wire** (found by review: each was returned without a word): xi outside [0, 1] (the
+  ``authors2020`` rule's start formulas do not clip it, docs/hysteresis.md); a wire in
+  compression, which a wire cannot take; a wire colder than anything can cool it (below both
+  the ambient and its start, with no latent heat to absorb), or a casing colder than its air
+  and its wire: a numerical instability, the run's numbers finite;
+- **a joint turned over**: the angle beyond +-:data:`JOINT_RANGE_DEG`.
 
 The warnings go into the run's metrics (``warnings``: a list of one-line texts) and so into
 every summary; the command line prints them.
@@ -34,6 +40,14 @@ STRESS_RATING_PA = 200e6
 STRAIN_MARGIN = 0.01
 #: a first sample of xi this far from xi_init: the start was placed onto the major loop
 XI_START_TOLERANCE = 1e-6
+#: xi this far outside [0, 1]: a martensite fraction no wire has
+XI_RANGE_TOLERANCE = 1e-9
+#: a wire stress below this [Pa]: the wire pushes (rounding tolerated)
+COMPRESSION_PA = -1e3
+#: a temperature this far below the coldest it can cool to [degC]
+COLD_MARGIN_C = 1.0
+#: a joint angle beyond +- this [deg]: the finger has turned over
+JOINT_RANGE_DEG = 180.0
 
 
 def austenite_finish_C(sigma_Pa: np.ndarray, A_F0_C: float, c_A_Pa_per_C: float) -> np.ndarray:
@@ -83,10 +97,47 @@ def check(result) -> list[str]:
             out.append(f"{w} wire: strain {strain:.3g} at t = {at:.3g} s, beyond the recoverable strain "
                        f"eps_R = {p.eps_R:g} (+{STRAIN_MARGIN:g}): the wire would deform plastically, "
                        "which the model does not describe")
+        out += _impossible_wire(result, p, w, xi, sigma, T, t)
+    if p.mechanism == "joint":
+        peak, at = _peak(np.abs(result.theta_deg), t)
+        if peak > JOINT_RANGE_DEG:
+            out.append(f"joint angle {peak:,.4g} deg at t = {at:.3g} s, beyond +-{JOINT_RANGE_DEG:g} deg: the finger "
+                       "has turned over; a numerical instability (check dt_s and the method) or a drive far too strong")
     if p.V_L_V > 0.0 and len(p.wire_names) > 1:  # the joint's two wires pull against each other
         out.append(f"V_L_V = {p.V_L_V:g} V drives every wire whose duty is 0 (Fig. 6's low level): the opposing "
                    "wires are heated at once whenever one is not pulsed, which the interlock counter, counting "
                    "drives above V_L, does not count")
+    return out
+
+
+def _impossible_wire(result, p, w: str, xi, sigma, T, t) -> list[str]:
+    """The warnings of values no wire has: xi outside [0, 1], compression, cooling below what can cool it."""
+    out = []
+    hi, at_hi = _peak(xi, t)
+    lo, at_lo = _peak(-xi, t)
+    lo = -lo
+    if hi > 1.0 + XI_RANGE_TOLERANCE or lo < -XI_RANGE_TOLERANCE:
+        value, at = (hi, at_hi) if hi > 1.0 + XI_RANGE_TOLERANCE else (lo, at_lo)
+        why = (" (the authors2020 rule's start formulas do not clip it, docs/hysteresis.md)"
+               if p.hysteresis == "authors2020" else "")
+        out.append(f"{w} wire: xi = {value:.4g} at t = {at:.3g} s, outside [0, 1]: a martensite fraction no wire "
+                   f"has{why}")
+    least, at = _peak(-sigma, t)
+    if -least < COMPRESSION_PA:
+        out.append(f"{w} wire: stress {-least / 1e6:.4g} MPa at t = {at:.3g} s: the wire pushes, which a wire cannot")
+    coldest = min(p.T_amb_C, p.T_init_C) - COLD_MARGIN_C
+    cold, at = _peak(-T, t)
+    if p.latent_heat_J_kg == 0.0 and -cold < coldest:
+        out.append(f"{w} wire: {-cold:.4g} degC at t = {at:.3g} s, colder than the ambient and its start "
+                   f"({min(p.T_amb_C, p.T_init_C):g} degC) with nothing to cool it: a numerical instability "
+                   "(check dt_s and the method)")
+    if f"T_casing_{w}_C" not in result.column_names:  # a run that recorded only its metrics' signals
+        return out
+    case, at = _peak(-result.signal(f"T_casing_{w}_C"), t)
+    if -case < min(coldest, float(np.nanmin(T)) - COLD_MARGIN_C):
+        out.append(f"{w} casing: {-case:.4g} degC at t = {at:.3g} s, colder than its air and its wire: a numerical "
+                   "instability (check dt_s and the method; a small casing_heat_capacity_J_mK makes the casing "
+                   "node stiff)")
     return out
 
 

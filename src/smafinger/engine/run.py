@@ -25,12 +25,17 @@ from .schedule import Segments
 from .clock import TICK_S, ticks_array, to_ticks  # noqa: F401  (re-exported)
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_OUTPUT_S, DEFAULT_PWM, DEFAULT_TOL_DEG,  # noqa: F401
                        DEFAULT_TOL_M, ENGINES)
-from .substep import STATUS_BAD_DUTY, STATUS_OK
+from .substep import Q_MAX, STATUS_BAD_DUTY, STATUS_OK, T_MAX_C, T_MIN_C
 from .signals import MC, MECHANISM_FIELDS, METRIC_FIELDS, WIRE_FIELDS, check_recorded, every_signal, new_outputs
+
+#: the state's physical range (:func:`.substep._finite`), as the blow-up error states it
+PHYSICAL_RANGE = (f"temperatures {T_MIN_C:g} to {T_MAX_C:g} degC, the coordinate within +-{Q_MAX:g} rad or m; "
+                  "stress, xi and load finite")
 
 
 class SimulationError(RuntimeError):
-    """The run diverged (NaN or Inf); the message holds the time and the state."""
+    """The run diverged (NaN or Inf, or the state out of its physical range, :data:`PHYSICAL_RANGE`);
+    the message holds the time and the state."""
 
 
 class DutyNotANumber(SimulationError):
@@ -280,7 +285,8 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
                               f"(controller {spec.controller.label if spec.controller else 'pid'!r}; does it "
                               f"read a sensor it does not declare?): {describe_state(spec.params, state)}")
     if counters.status != STATUS_OK:
-        raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s: {describe_state(spec.params, state)}")
+        raise SimulationError(f"numerical blow-up at t = {t_fail:.9g} s (a value NaN or infinite, or the state "
+                              f"out of any physical range: {PHYSICAL_RANGE}): {describe_state(spec.params, state)}")
     check_recorded(mech)
     return SimulationResult(
         spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=seg_actual * TICK_S,

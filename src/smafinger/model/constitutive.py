@@ -110,7 +110,13 @@ def _spring_elongation_bracketed(F, K_S, x_limit, fact):
 
 @njit(cache=True, forceinline=True)
 def equivalent_modulus(K_s, D, S_w, L_w):
-    """D_eq = K_eq L_w / S_w with K_eq = K_s K_D / (K_s + K_D) (Eq. 8) [Pa]."""
+    """D_eq = K_eq L_w / S_w with K_eq = K_s K_D / (K_s + K_D) (Eq. 8) [Pa].
+
+    A spring stiffened past what a float holds (the slack penalty's cosh overflowed: K_s = inf)
+    is rigid: D_eq = D (inf / inf gave NaN; found by review, a thin wire at the largest penalty).
+    """
+    if K_s == math.inf:
+        return D
     K_D = D * S_w / L_w
     return K_s * K_D / (K_s + K_D) * L_w / S_w
 
