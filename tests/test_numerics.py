@@ -78,6 +78,29 @@ def test_the_default_is_the_long_step_only_where_it_was_validated(kw, want):
     assert refusal is None or (edge_step_refusal(spec.params, spec.controller, spec.t_end_s) is None) == (want == EDGE)
 
 
+@pytest.mark.parametrize("changes, program, steps, refused", [
+    ({}, "0:0.6,6:0", 45.5, False),  # the validated program's strongest step
+    ({}, "0:1,6:0", 25.5, False),
+    ({"V_H_V": 16.0}, "0:1,3:0", 13.76, True),
+    ({"V_H_V": 24.0}, "0:1,0.5:0", 5.94, True),
+    ({"wire_length_m": 0.2}, "0:0.3,6:0", 3.14, True),
+])
+def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes, program, steps, refused):
+    """The linear rig heated across its transformation band in a few long steps gave a false
+    trajectory (24 V: the slider at its end stop, 855 MPa against 122 with rk4 at 0.1 ms; found
+    by review). The band must take MIN_BAND_STEPS long steps at the run's strongest drive."""
+    from smafinger.engine.numerics import MIN_BAND_STEPS, _fast_transformation
+
+    p = get("linear-bias-spring").replace(**changes)
+    spec = make_spec(p, "open-loop", voltage=program, drive="duty", t_end_s=8.0)
+    why = _fast_transformation(p, spec.voltage)
+    assert (why is not None) == refused == (steps < MIN_BAND_STEPS)
+    assert _numerics(spec) == (REF if refused else STIFF)
+    if refused:
+        ms = float(why.split(" in ")[1].split(" ms")[0])
+        assert ms == pytest.approx(5.0 * steps, rel=0.01) and f"fewer than {MIN_BAND_STEPS} long steps" in why
+
+
 def test_other_gains_keep_the_default_within_the_budget():
     """The period-averaged PWM at the long step put the full cycle's reach times 0.1-0.5 s late
     with other PID gains (K_V 300: 2.5 deg RMS, 11.9 deg max from rk4 at 0.1 ms; found by review):

@@ -41,6 +41,15 @@ from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S
 #: With the rate law the wires move at the mechanism's mean rate over a step and any program
 #: holds (docs/speed.md).
 PROGRAM_MIN_STEP_S = 0.5
+#: the long step needs at least this many steps across the transformation band (A_S0 to A_F0)
+#: at the run's strongest drive (:func:`_fast_transformation`). Measured on the linear rig in
+#: open loop against RK4 at 0.1 ms (position RMS / max, peak stress): the validated drives
+#: cross it in 45.5 steps (0.05 / 0.51 mm over an 18 mm stroke, 48 against 46 MPa) and 25.5
+#: (0.07 / 0.95 mm); 13.8 steps gave 2.0 mm max, 8.6 steps 0.7 mm over a 3.6 mm stroke and
+#: 54 against 43 MPa, and 3-6 steps a false trajectory (the slider between its end stops, 741-855
+#: against 52-122 MPa; found by review). The paper's and the authors' sets at their drives: 266
+#: and 230 steps.
+MIN_BAND_STEPS = 20
 
 
 @dataclass(frozen=True)
@@ -141,11 +150,45 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
             return other
     if params.pwm_period_s > LONG_STEP_DT_S:
         return f"pwm_period_s = {params.pwm_period_s:g} is longer than the long step ({LONG_STEP_DT_S:g} s)"
+    if (fast := _fast_transformation(params, program)) is not None:
+        return fast
     if opts.stress_law == StressLaw.ALGEBRAIC and program is not None and len(program.steps) > 1:
         gap = float(np.min(np.diff(program.arrays()[0])))
         if gap < PROGRAM_MIN_STEP_S:
             return (f"the drive program has steps {gap:g} s apart (the long step needs {PROGRAM_MIN_STEP_S:g} s or "
                     "more with the algebraic stress law)")
+    return None
+
+
+def _strongest_drive(params, program) -> tuple[float, bool]:
+    """(the strongest drive a wire of the run gets, as its period's root mean square [V or A];
+    whether it is a current): V_H in closed loop (any duty up to 100 %), the program's largest
+    step in open loop (a duty program's fraction of V_H at that duty)."""
+    if program is None:
+        return params.V_H_V, False
+    values = np.column_stack(program.arrays()[1:])
+    if program.kind == "duty":
+        return params.V_H_V * float(np.sqrt(values.max())), False
+    return float(values.max()), program.kind == "current"
+
+
+def _fast_transformation(params, program) -> str | None:
+    """Why the transformation is too fast for the long step (None: it is not): the wire heats
+    across its band A_S0 to A_F0 in fewer than :data:`MIN_BAND_STEPS` long steps at the run's
+    strongest drive (Eq. 11 at A_S0 with the heating coefficients: its fastest heating there)."""
+    from ..model.build import build_model
+    from ..model.heat import wire_temperature_rate
+
+    drive, current = _strongest_drive(params, program)
+    model = build_model(params)
+    wire = model.wires[0]  # every wire has the set's thermal fields
+    rate = wire_temperature_rate(wire, params.A_S0_C, params.T_amb_C, drive, True, current, model.options)
+    band = params.A_F0_C - params.A_S0_C
+    if rate > 0.0 and band < MIN_BAND_STEPS * LONG_STEP_DT_S * rate:
+        unit = "A" if current else "V"
+        return (f"the wire crosses its transformation band ({params.A_S0_C:g} to {params.A_F0_C:g} degC) in "
+                f"{1e3 * band / rate:.3g} ms at its strongest drive ({drive:.4g} {unit}: {rate:.4g} degC/s), fewer "
+                f"than {MIN_BAND_STEPS} long steps of {1e3 * LONG_STEP_DT_S:g} ms")
     return None
 
 
