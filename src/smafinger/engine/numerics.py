@@ -127,7 +127,9 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
       with the rate law: steps end at its switches, and with the wires moved at the mechanism's
       mean rate over a step (:mod:`.integrators`) an 80 % square wave at 8 V stayed within
       0.008 deg RMS, 0.06 deg max of rk4 at 0.1 ms for periods from 2 s down to 5 ms. With the
-      algebraic law its steps must be :data:`PROGRAM_MIN_STEP_S` apart or more.
+      algebraic law its steps must be :data:`PROGRAM_MIN_STEP_S` apart or more;
+    - a transformation that takes :data:`MIN_BAND_STEPS` long steps or more at the run's
+      strongest drive (:func:`_fast_transformation`).
     """
     opts = params.options
     if (short := _shorter_than_the_step(t_end_s)) is not None:
