@@ -207,6 +207,27 @@ def test_a_temperature_nothing_can_reach_is_warned_of_at_its_threshold():
         assert all("numerical instability" in w for w in out)
 
 
+def test_a_heating_resistance_that_is_not_the_wires_is_warned_of():
+    """A changed wire_diameter_m alone kept the 0.5 mm wire's 4.1 ohm/m in Eq. (11): a 0.25 mm
+    wire heated with 5x the power its resistance gives, without a word (found by review)."""
+    from smafinger.plausibility import RESISTANCE_MISMATCH, _resistance_mismatch
+
+    rig = get("linear-bias-spring")
+    (w,) = _resistance_mismatch(rig.replace(wire_diameter_m=0.25e-3))
+    assert w.startswith("resistance_ohm_per_m = 4.1 ohm/m heats the wire") and "(5.07x)" in w
+    assert _resistance_mismatch(rig) == []  # 1.27x
+    from smafinger.model.build import build_model
+    from smafinger.model.resistance import resistivity
+
+    wire = build_model(rig).wires[0]
+    per_m = resistivity.py_func(wire, rig.T_init_C, rig.xi_init) / wire.area_m2  # Eq. R1 at the start, ohm/m
+    assert per_m / 4.1 == pytest.approx(1.268, abs=1e-3)
+    assert _resistance_mismatch(rig.replace(resistance_ohm_per_m=per_m / (RESISTANCE_MISMATCH * 0.999))) == []
+    assert len(_resistance_mismatch(rig.replace(resistance_ohm_per_m=per_m / (RESISTANCE_MISMATCH * 1.001)))) == 1
+    r = simulate(rig.replace(wire_diameter_m=0.25e-3), "open-loop", voltage="0:0.3,1:0", drive="duty", t_end_s=2.0)
+    assert any(x.startswith("resistance_ohm_per_m") for x in r.metrics["warnings"])
+
+
 def resolve_with(*overrides):
     return get("paper2010").with_overrides(list(overrides))
 

@@ -21,7 +21,12 @@ survives either. :func:`check` flags, per wire:
   compression, which a wire cannot take; a wire colder than anything can cool it (below both
   the ambient and its start, with no latent heat to absorb), or a casing colder than its air
   and its wire: a numerical instability, the run's numbers finite;
-- **a joint turned over**: the angle beyond +-:data:`JOINT_RANGE_DEG`.
+- **a joint turned over**: the angle beyond +-:data:`JOINT_RANGE_DEG`;
+- **a heating resistance that is not this wire's**: Eq. (11) heats with the set's
+  ``resistance_ohm_per_m``, while the wire's resistivities (``model.resistance``, Eq. R1) give
+  another at its diameter: more than :data:`RESISTANCE_MISMATCH` times apart (a changed
+  ``wire_diameter_m`` alone heated a 0.25 mm wire with the 0.5 mm wire's 4.1 ohm/m, 5x the
+  power its resistance gives; found by review). The named sets are within 1.27x.
 
 The warnings go into the run's metrics (``warnings``: a list of one-line texts) and so into
 every summary; the command line prints them.
@@ -48,6 +53,8 @@ COMPRESSION_PA = -1e3
 COLD_MARGIN_C = 1.0
 #: a joint angle beyond +- this [deg]: the finger has turned over
 JOINT_RANGE_DEG = 180.0
+#: the heating resistance and the resistivities' this many times apart (either way)
+RESISTANCE_MISMATCH = 1.5
 
 
 def austenite_finish_C(sigma_Pa: np.ndarray, A_F0_C: float, c_A_Pa_per_C: float) -> np.ndarray:
@@ -103,11 +110,29 @@ def check(result) -> list[str]:
         if peak > JOINT_RANGE_DEG:
             out.append(f"joint angle {peak:,.4g} deg at t = {at:.3g} s, beyond +-{JOINT_RANGE_DEG:g} deg: the finger "
                        "has turned over; a numerical instability (check dt_s and the method) or a drive far too strong")
+    out += _resistance_mismatch(p)
     if p.V_L_V > 0.0 and len(p.wire_names) > 1:  # the joint's two wires pull against each other
         out.append(f"V_L_V = {p.V_L_V:g} V drives every wire whose duty is 0 (Fig. 6's low level): the opposing "
                    "wires are heated at once whenever one is not pulsed, which the interlock counter, counting "
                    "drives above V_L, does not count")
     return out
+
+
+def _resistance_mismatch(p) -> list[str]:
+    """The warning of a heating resistance the wire's resistivities do not give (at the start)."""
+    import math
+
+    from .model.build import build_model
+    from .model.resistance import resistivity
+
+    wire = build_model(p).wires[0]  # every wire has the set's electrical fields
+    per_m = resistivity.py_func(wire, p.T_init_C, p.xi_init) / wire.area_m2
+    ratio = per_m / p.resistance_ohm_per_m
+    if max(ratio, 1.0 / ratio) <= RESISTANCE_MISMATCH or not math.isfinite(ratio):
+        return []
+    return [f"resistance_ohm_per_m = {p.resistance_ohm_per_m:g} ohm/m heats the wire (Eq. 11), but its resistivities "
+            f"give {per_m:.4g} ohm/m at its diameter of {1e3 * p.wire_diameter_m:g} mm ({ratio:.3g}x): set "
+            "resistance_ohm_per_m for this wire (the R_*_ohm signals and self-sensing use the resistivities)"]
 
 
 def _impossible_wire(result, p, w: str, xi, sigma, T, t) -> list[str]:
