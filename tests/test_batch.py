@@ -50,7 +50,7 @@ def test_parallel_results_bit_identical_to_single_runs():
     for a, b in zip(alone, together):
         assert b.spec == a.spec  # input order kept
         pd.testing.assert_frame_equal(a.to_pandas(), b.to_pandas(), check_exact=True)
-        assert np.array_equal(a.segment_start_s, b.segment_start_s)
+        assert np.array_equal(a.segment_start_s, b.segment_start_s, equal_nan=True)
         assert np.array_equal(a.segment_reached_s, b.segment_reached_s, equal_nan=True)
         assert (a.substeps, a.interlock_violations) == (b.substeps, b.interlock_violations)
         assert _summary(a) == _summary(b)

@@ -118,6 +118,14 @@ def test_a_stress_solve_that_fails_is_a_blow_up():
         assert np.all(np.isfinite(r.signal(name))), name
 
 
+def test_a_segment_that_never_starts_has_no_start_time():
+    """Its start was -1e-9 s (the kernel's -1 marker times the tick), a time API users read as one
+    (found by review)."""
+    r = simulate("paper2010", "cooperative", "0:-55,reach:-25", t_end_s=1.0)
+    assert r.segment_start_s[0] == 0.0 and np.isnan(r.segment_start_s[1]) and np.isnan(r.segment_reached_s[1])
+    assert [seg["index"] for seg in r.summary()["segments"]] == [0]  # the summary lists the started ones
+
+
 @pytest.mark.parametrize("numerics", [{}, {"method": "rk4"}])  # the long-step default, the reference
 def test_interlock_counter_counts_a_forced_violation(numerics):
     spec = make_spec("paper2010", "open-loop", voltage="0:8:0", t_end_s=0.1, **numerics)

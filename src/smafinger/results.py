@@ -45,7 +45,7 @@ class SimulationResult:
     spec: Any
     mechanism_signals: np.ndarray
     wire_signals: np.ndarray
-    segment_start_s: np.ndarray
+    segment_start_s: np.ndarray  #: each segment's start [s]; NaN for a segment that never started
     segment_reached_s: np.ndarray
     substeps: int
     interlock_violations: int

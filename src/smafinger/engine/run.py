@@ -289,7 +289,7 @@ def run_spec(spec: RunSpec, progress=False, engine="compiled", record="all") -> 
                               f"out of any physical range: {PHYSICAL_RANGE}): {describe_state(spec.params, state)}")
     check_recorded(mech)
     return SimulationResult(
-        spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=seg_actual * TICK_S,
+        spec=spec, mechanism_signals=mech, wire_signals=wires, segment_start_s=np.where(seg_actual >= 0, seg_actual * TICK_S, np.nan),
         segment_reached_s=np.where(seg_reached >= 0, (seg_reached - seg_actual) * TICK_S, np.nan),
         substeps=int(counters.substeps), interlock_violations=int(counters.violations), wall_s=wall,
         engine="interpreted" if INTERPRETED else "compiled",
