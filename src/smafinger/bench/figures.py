@@ -93,7 +93,7 @@ def task_figure(records: dict, task: Task):
     axes[0, 0].legend(fontsize=8, loc="best")
     fig.suptitle(task.description, fontsize=9)
     fig.tight_layout()
-    return f"{task.mechanism}-{task.name}", png(fig)
+    return task_figure_name(task), png(fig)
 
 
 def bandwidth_figure(rows: pd.DataFrame, mechanism: str, tasks: Sequence[Task]):
@@ -116,7 +116,17 @@ def bandwidth_figure(rows: pd.DataFrame, mechanism: str, tasks: Sequence[Task]):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     fig.tight_layout()
-    return f"{mechanism}-bandwidth", png(fig)
+    return bandwidth_figure_name(mechanism), png(fig)
+
+
+def task_figure_name(task: Task) -> str:
+    """A task's figure's name (without ``.png``): ``MECHANISM-TASK``."""
+    return f"{task.mechanism}-{task.name}"
+
+
+def bandwidth_figure_name(mechanism: str) -> str:
+    """A mechanism's sine gains' figure's name (without ``.png``)."""
+    return f"{mechanism}-bandwidth"
 
 
 def png(fig) -> bytes:

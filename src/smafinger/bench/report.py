@@ -1,8 +1,10 @@
 """The bench's outputs: the table (CSV with a ``controller`` column, and Markdown), the -3 dB
 bandwidths, the issue's goals checked, and a figure per task (:mod:`.figures`).
 
-Everything is computed before anything is written, and every file is written whole
-(:func:`smafinger.files.atomic_write`).
+Everything is computed before anything is written, and the files replace what an earlier bench
+wrote in the folder all at once (:func:`smafinger.outdir.staged`, with the bench's own file
+names, :func:`own_files`): no file of an earlier bench (a figure of a task not run this time)
+stays beside the new ones, and a failure leaves the folder as it was.
 """
 
 from __future__ import annotations
@@ -14,9 +16,9 @@ from typing import Callable, Sequence
 
 import pandas as pd
 
-from ..files import atomic_write, atomic_write_text
+from ..outdir import OwnFiles, check_out_dir, staged
 from .runner import BenchResult
-from .tasks import Task
+from .tasks import ALL_TASKS, Task
 
 #: the goals of issue 15 (checked by :func:`goals`)
 SPEED_GAIN = 0.30  #: the best controller completes the Fig. 15 cycle at least this much faster
@@ -154,11 +156,41 @@ def markdown(res: BenchResult, tasks: Sequence[Task]) -> str:
     return "\n".join(parts)
 
 
+#: the bench's files in its folder; its figures go to :data:`FIGURES_DIR`
+TABLE_FILES = ("controllers.csv", "bandwidth.csv", "controllers.md", "goals.json")
+FIGURES_DIR = "figures"
+
+
+def figure_names(tasks: Sequence[Task] = ALL_TASKS) -> frozenset[str]:
+    """The PNG names :mod:`.figures` gives ``tasks``' figures: ``MECHANISM-TASK.png`` per task
+    (:func:`.figures.task_figure`) and ``MECHANISM-bandwidth.png`` per mechanism with a sine
+    task (:func:`.figures.bandwidth_figure`); by default of every task a bench can run."""
+    from .figures import bandwidth_figure_name, task_figure_name
+
+    names = {f"{task_figure_name(t)}.png" for t in tasks}
+    names |= {f"{bandwidth_figure_name(t.mechanism)}.png" for t in tasks if t.kind == "sine"}
+    return frozenset(names)
+
+
+def own_files() -> OwnFiles:
+    """What a bench writes into its ``--out``, by exact names (:mod:`smafinger.outdir`): the
+    tables, and in ``figures/`` the figure of every task any bench can run
+    (:data:`~.tasks.ALL_TASKS`), so that a second bench removes the figures of tasks it did not run."""
+    return OwnFiles("bench-controllers", "a bench", frozenset(TABLE_FILES), {FIGURES_DIR: figure_names()})
+
+
 def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bool = True, pool=None,
                  on_progress: Callable[[int, int], None] | None = None) -> list[Path]:
     """Write controllers.csv, bandwidth.csv, controllers.md, goals.json and the figures into ``out``
     (the figures drawn on ``pool`` if given, ``on_progress(done, total)`` after each:
-    :func:`.figures.task_figures`)."""
+    :func:`.figures.task_figures`); returns the files' paths.
+
+    All or nothing (:func:`smafinger.outdir.staged`): the files are written into a hidden folder
+    inside ``out`` and then replace whatever an earlier bench wrote there (:func:`own_files`;
+    ``figures/`` too, so ``figures=False`` leaves none). ``out`` may be new (its parent a
+    folder) or a folder holding only a bench's files; else
+    :class:`~smafinger.files.OutputError` (:func:`smafinger.outdir.check_out_dir`, which the
+    command line calls before the runs)."""
     out = Path(out)
     text = markdown(res, tasks)
     g = goals(res.rows)
@@ -167,18 +199,18 @@ def write_report(res: BenchResult, tasks: Sequence[Task], out: Path, figures: bo
         from .figures import task_figures
 
         plots = task_figures(res, tasks, pool, on_progress)  # (name, PNG bytes), drawn before anything is written
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, frame in (("controllers.csv", res.rows), ("bandwidth.csv", res.bandwidth)):
-        atomic_write(out / name, lambda tmp, f=frame: f.to_csv(tmp, index=False))
-        written.append(out / name)
-    atomic_write_text(out / "controllers.md", text + "\n")
-    atomic_write_text(out / "goals.json", json.dumps(g, indent=2) + "\n")
-    written += [out / "controllers.md", out / "goals.json"]
-    if plots:
-        (out / "figures").mkdir(exist_ok=True)
-        for name, data in plots:
-            path = out / "figures" / f"{name}.png"
-            atomic_write(path, lambda tmp, d=data: Path(tmp).write_bytes(d))
-            written.append(path)
-    return written
+    own = own_files()
+    odd = [name for name, _ in plots if f"{name}.png" not in own.folders[FIGURES_DIR]]
+    if odd:  # figures.py names a figure figure_names does not: a second bench could not remove it
+        raise RuntimeError(f"figure {odd[0]!r} is not among the bench's own file names (bench/report.py figure_names)")
+    check_out_dir(out, own)  # before the folder is made: a bad --out leaves nothing
+    with staged(out, own) as stage:
+        for name, frame in (("controllers.csv", res.rows), ("bandwidth.csv", res.bandwidth)):
+            frame.to_csv(stage / name, index=False)
+        (stage / "controllers.md").write_text(text + "\n", encoding="utf-8")
+        (stage / "goals.json").write_text(json.dumps(g, indent=2) + "\n", encoding="utf-8")
+        if plots:
+            (stage / FIGURES_DIR).mkdir()
+            for name, data in plots:
+                (stage / FIGURES_DIR / f"{name}.png").write_bytes(data)
+    return [out / name for name in TABLE_FILES] + [out / FIGURES_DIR / f"{name}.png" for name, _ in plots]

@@ -42,8 +42,9 @@ def _tasks(mechanisms: list[str], names: list[str], quick: bool = False):
 
 
 def bench_controllers(
-    out: Path = typer.Option(..., "--out", "-o", help="directory for controllers.csv, controllers.md, "
-                                                       "bandwidth.csv, goals.json and figures/"),
+    out: Path = typer.Option(..., "--out", "-o", help="folder for controllers.csv, controllers.md, bandwidth.csv, "
+                                                       "goals.json and figures/ (created if needed; an earlier "
+                                                       "bench's files there are replaced, other files refused)"),
     mechanism: List[str] = typer.Option([], "--mechanism", "-m", help=f"one of {', '.join(MECHANISMS)} "
                                                                       "(repeat; default: both)"),
     task: List[str] = typer.Option([], "--task", "-t", help="run only this task (repeat; default: every task)"),
@@ -64,9 +65,11 @@ def bench_controllers(
     Markdown table is printed too.
     """
     from ..bench.presets import BENCH_CONTROLLERS, QUICK_CONTROLLERS
-    from ..bench.report import markdown, write_report
+    from ..bench.report import markdown, own_files, write_report
     from ..bench.runner import STRATEGIES, run_bench
     from ..engine.batch import BatchError, make_pool
+    from ..files import OutputError
+    from ..outdir import check_out_dir
 
     bad = [c for c in controller if c not in BENCH_CONTROLLERS]
     if bad:
@@ -76,8 +79,10 @@ def bench_controllers(
         _fail(f"--strategy {bad[0]!r} is not one of {', '.join(STRATEGIES)}")
     if workers is not None and workers < 1:
         _fail(f"--workers {workers}: must be >= 1")
-    if out.exists() and not out.is_dir():
-        _fail(f"--out {out}: exists and is not a directory")
+    try:  # before any run: a file, a missing parent, a folder holding files a bench does not write
+        check_out_dir(out, own_files())
+    except OutputError as exc:
+        _fail(str(exc))
     tasks = _tasks(mechanism, task, quick)
     if not tasks:
         _fail("--mechanism/--task/--quick: no task left to run")
@@ -89,9 +94,13 @@ def bench_controllers(
                             on_progress=display.counter("bench-controllers", "runs"))
         except BatchError as exc:
             _fail(str(exc), code=1)
+        # all or nothing: staged inside --out, then replacing what an earlier bench wrote there
         write_report(res, tasks, out, figures=figures, pool=pool, on_progress=display.counter("figures", "figures"))
-    print(markdown(res, tasks))
-    _say(f"written to {out}")
+    try:
+        print(markdown(res, tasks))
+        _say(f"written to {out}")
+    except KeyboardInterrupt:  # the outputs are in place: not "no output was written"
+        raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
 
 
 def tune(

@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import fnmatch
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable
 
+from .. import outdir
 from ..engine.run import RunSpec
 from ..files import JSON_DIGITS, json_ready, write_json  # noqa: F401  (json_ready re-exported)
+from ..outdir import STAGE_PREFIX, OwnFiles  # noqa: F401  (STAGE_PREFIX re-exported)
 from ..results import SimulationResult
 from . import investigation as inv
 from . import scenarios as scn
@@ -207,10 +208,6 @@ def _write_file(job: _FigureFile | _RunCsv) -> None:
     job.write()
 
 
-#: the hidden folder a reproduce writes into, inside its ``--out`` (``.partial-XXXXXXXX``)
-STAGE_PREFIX = ".partial-"
-
-
 def own_files() -> tuple[frozenset[str], frozenset[str]]:
     """The names a reproduce writes: (in its folder, in its ``runs/``). Exact names, so that a
     file of the user's that merely looks like one (``holiday.png``) is never taken for it."""
@@ -219,38 +216,17 @@ def own_files() -> tuple[frozenset[str], frozenset[str]]:
     return frozenset(top), frozenset(runs)
 
 
-def _foreign(out_dir: Path) -> list[Path]:
-    """What ``out_dir`` holds that no reproduce writes (a killed reproduce's hidden folder is its own)."""
+def _own() -> OwnFiles:
+    """:func:`own_files` for :mod:`smafinger.outdir` (its rule for ``--out``)."""
     top, runs = own_files()
-    out = [p for p in out_dir.iterdir()
-           if not (p.is_file() and p.name in top) and not (p.name == "runs" and p.is_dir())
-           and not (p.is_dir() and p.name.startswith(STAGE_PREFIX))]
-    if (out_dir / "runs").is_dir():
-        out += [p for p in (out_dir / "runs").iterdir() if not (p.is_file() and p.name in runs)]
-    return out
+    return OwnFiles("reproduce", "a reproduce", top, {"runs": runs})
 
 
 def check_out_dir(out_dir: str | Path) -> None:
     """:class:`~smafinger.files.OutputError` (bad input) unless ``out_dir`` can take a reproduce:
     new (its parent a writable folder), or a writable folder that is empty or holds only what
-    a reproduce writes (:func:`own_files`)."""
-    import os
-
-    from ..files import OutputError
-
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise OutputError(f"--out {out_dir}: is a file; give a folder (created if needed)")
-    where = out_dir if out_dir.exists() else Path(os.path.abspath(out_dir)).parent
-    if not where.is_dir():
-        raise OutputError(f"--out {out_dir}: folder {where} does not exist")
-    if not os.access(where, os.W_OK | os.X_OK):
-        raise OutputError(f"--out {out_dir}: folder {where} is not writable")
-    foreign = _foreign(out_dir) if out_dir.exists() else []
-    if foreign:
-        raise OutputError(f"--out {out_dir}: holds {foreign[0].relative_to(out_dir)}, which reproduce does not "
-                          f"write; a reproduce replaces what an earlier one wrote there: give a new folder, or "
-                          f"one only reproduce wrote")
+    a reproduce writes (:func:`own_files`); the rule is :func:`smafinger.outdir.check_out_dir`."""
+    outdir.check_out_dir(out_dir, _own())
 
 
 def check_investigate(names: Iterable[str], investigate: bool | None) -> bool:
@@ -282,10 +258,7 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     no file of an earlier run stays beside the new ones. Interrupted or failed before that, the
     hidden folder is removed and ``out_dir`` is as it was (a folder it made is removed too).
     """
-    import shutil
-    import tempfile
-
-    from ..engine.batch import BatchError, available_cores
+    from ..engine.batch import available_cores
 
     t0 = time.perf_counter()
     out_dir = Path(out_dir)
@@ -295,10 +268,7 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
     investigate = check_investigate(names, investigate)
     tasks = [(s.name, s.spec()) for s in chosen] + (inv.tasks(names) if investigate else [])
     n_workers = max(1, min(workers or available_cores(), len(tasks)))
-    made = not out_dir.exists()
-    out_dir.mkdir(exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=STAGE_PREFIX, dir=out_dir))
-    try:
+    with outdir.staged(out_dir, _own()) as stage:  # all or nothing, out_dir as it was on any failure
         (stage / "runs").mkdir()
         derivations = inv.derivations() if investigate else {}
         derivations.update({s.name: s.derive for s in chosen})
@@ -315,77 +285,8 @@ def reproduce(out_dir: str | Path, only: Iterable[str] | None = None, workers: i
         outcomes = [c.evaluate(scen_runs) for c in scn.claims()]
         wall = time.perf_counter() - t0
         write_report(stage / "report.md", outcomes, rows, runs, figures, wall, n_workers, tables)
-        with _sigint_held():  # from the last check to the last rename: all the old, or all the new
-            check_out_dir(out_dir)  # still only what a reproduce writes
-            _publish(stage, out_dir)
-    except BaseException as exc:
-        shutil.rmtree(stage, ignore_errors=True)
-        if made:
-            try:
-                out_dir.rmdir()  # made here and empty again
-            except OSError:
-                pass
-        if isinstance(exc, BatchError):  # a worker died: nothing is kept
-            raise BatchError(f"{exc}; no output was written ({out_dir} is as it was)") from None
-        raise
     figures = [out_dir / p.relative_to(stage) for p in figures]
     return ReproduceOutput(out_dir, runs, outcomes, rows, figures, wall, [k for k, r in runs.items() if not r.ok])
-
-
-@contextmanager
-def _sigint_held():
-    """Ctrl-C ignored inside (in the main thread; elsewhere nothing to hold)."""
-    import signal
-    import threading
-
-    held = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN) if held else None
-    try:
-        yield
-    finally:
-        if held and previous is not None:
-            signal.signal(signal.SIGINT, previous)
-
-
-def _publish(stage: Path, out_dir: Path) -> None:
-    """Replace what an earlier reproduce wrote in ``out_dir`` by ``stage``'s files, by renames
-    within ``out_dir`` (no copy): the old ones moved into ``stage/.old``, the new ones moved in,
-    then ``stage`` removed. An OSError on the way moves everything back (``out_dir`` as it was)
-    and is raised naming the file (found by review: a ``runs/`` not writable left the folder
-    without its summary and report)."""
-    import shutil
-
-    top, runs = own_files()
-    old = stage / ".old"
-    (old / "runs").mkdir(parents=True)
-    moved: list[tuple[Path, Path]] = []  # (from, to), in order
-
-    def move(src: Path, dst: Path) -> None:
-        src.rename(dst)
-        moved.append((src, dst))
-
-    try:
-        for name in top:
-            if (out_dir / name).exists():
-                move(out_dir / name, old / name)
-        for name in runs:
-            if (out_dir / "runs" / name).exists():
-                move(out_dir / "runs" / name, old / "runs" / name)
-        (out_dir / "runs").mkdir(exist_ok=True)
-        for p in sorted((stage / "runs").iterdir()):
-            move(p, out_dir / "runs" / p.name)
-        for p in sorted(stage.iterdir()):
-            if p.name not in (".old", "runs"):
-                move(p, out_dir / p.name)
-    except OSError as exc:
-        for src, dst in reversed(moved):
-            try:
-                dst.rename(src)
-            except OSError:
-                pass
-        raise OSError(f"--out {out_dir}: the outputs could not be moved into place ({exc}); the earlier "
-                      f"outputs were put back") from None
-    shutil.rmtree(stage, ignore_errors=True)
 
 
 __all__ = ["reproduce", "check_out_dir", "check_investigate", "own_files", "STAGE_PREFIX", "run_tasks", "select",
