@@ -279,3 +279,60 @@ def test_a_changed_scenario_run_records_what_changed(here, capsys):
     assert prov["scenario_changes"] == "--set M_SF_Nm=0.02 --t-end 1.0"
     rc, _, _ = run(capsys, "simulate", "--scenario", "fig12-extension-v1", "--t-end", "1", "--out", "u.mat")
     assert rc == 0  # a .mat file holds them too (CI caught a list refused there)
+
+
+_FORKSERVER_CTRL_C = r"""
+import os, sys, time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import forkserver
+from smafinger.engine.forking import mp_context, start_forkserver
+
+start_forkserver(2)
+pid = forkserver._forkserver._forkserver_pid
+print("started", flush=True)
+try:
+    time.sleep(60)
+    sys.exit("no KeyboardInterrupt here")
+except KeyboardInterrupt:
+    pass
+with ProcessPoolExecutor(1, mp_context=mp_context()) as ex:  # forked from the same forkserver
+    assert ex.submit(os.getpid).result(timeout=60) != os.getpid()
+print("same forkserver" if forkserver._forkserver._forkserver_pid == pid else "forkserver restarted", flush=True)
+sys.exit(130)
+"""
+
+
+@pytest.mark.skipif("forkserver" not in __import__("multiprocessing").get_all_start_methods(),
+                    reason="no forkserver on this platform")
+def test_ctrl_c_while_the_forkserver_imports_leaves_it_alone(tmp_path):
+    """Found by review: a Ctrl-C in the first ~1.5 s of a sweep (the forkserver, in the terminal's
+    process group, still importing numba) killed the forkserver with a traceback of its imports.
+
+    Here SIGINT goes to the whole process group 0.2 s after the forkserver is started: the client
+    gets its KeyboardInterrupt, the forkserver nothing (no traceback), and it lives on to fork a
+    worker."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    proc = subprocess.Popen([sys.executable, "-c", _FORKSERVER_CTRL_C], cwd=tmp_path, env=env, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        assert proc.stdout.readline() == "started\n"
+        time.sleep(0.2)  # its imports take 1.5-2 s
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=120)  # stderr ends when the forkserver is gone too
+    finally:
+        proc.kill()
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert proc.returncode == 130 and out == "same forkserver\n", (proc.returncode, out, err)
+
+
+def test_a_ctrl_c_is_classified_without_importing_the_engine(monkeypatch):
+    """A Ctrl-C landing while numba was half imported made classify's own imports of the engine
+    raise: a traceback and exit status 1 instead of 130 (found by review)."""
+    import sys
+
+    from smafinger.cli.errors import EXIT_INTERRUPTED, classify
+
+    monkeypatch.setitem(sys.modules, "smafinger.engine.pools", None)  # importing it raises ImportError
+    monkeypatch.setitem(sys.modules, "smafinger.engine.run", None)
+    assert classify(KeyboardInterrupt()) == (EXIT_INTERRUPTED, "smafinger: interrupted (Ctrl-C)")

@@ -37,9 +37,28 @@ def mp_context():
 def start_forkserver(workers: int | None = None) -> None:
     """Start the forkserver now, in the background, if local workers will come from it:
     ``workers`` (default: every core) above 1 and a platform with a forkserver. It runs until
-    this process ends; pools started later use it."""
+    this process ends; pools started later use it.
+
+    The forkserver starts with SIGINT blocked (this thread's signal mask while it is spawned,
+    which a new process inherits): it is in this process's process group, which a terminal's
+    Ctrl-C reaches whole, and a Ctrl-C in the 1.5-2 s of its imports killed it with a traceback
+    of those imports. :mod:`.forkserver_warm` then ignores SIGINT there and unblocks it, so that
+    the workers forked from it have it unblocked as before (and ignored from their start, not
+    only from the pool's worker initializer on). This process's mask is restored at once: a
+    Ctrl-C that came meanwhile is delivered here then, as usual.
+    """
     if (workers or available_cores()) <= 1 or mp_context().get_start_method() != "forkserver":
         return
-    from multiprocessing import forkserver
+    import signal
+    from multiprocessing import forkserver, resource_tracker
 
-    forkserver.ensure_running()
+    # first, on its own: it unblocks SIGINT in this thread as it ends (it does the same for
+    # its own process), which would undo the mask below if forkserver.ensure_running() did it
+    resource_tracker.ensure_running()
+    sigmask = getattr(signal, "pthread_sigmask", None)
+    old = sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if sigmask is not None else None
+    try:
+        forkserver.ensure_running()
+    finally:
+        if sigmask is not None:
+            sigmask(signal.SIG_SETMASK, old)
