@@ -84,3 +84,32 @@ def test_a_resistance_calibration_that_cannot_estimate_is_refused(change, needle
         ResistanceFeedbackParameters(calibration={**good, **{k: list(v) if isinstance(v, tuple) else v
                                                              for k, v in change.items()}})
     assert dataclasses.asdict(ResistanceCalibration(**good))["c0"] == -0.7
+
+
+def test_a_microsecond_pwm_period_calibrates_with_the_averaged_pwm(monkeypatch):
+    """Found by review: a resistance-controller run on paper2010 at t_P = 1 us (0.2 s, averaged PWM)
+    took 189 s, all of it in the hidden calibration: 12 steps of 12 s with the PWM resolved, two
+    sub-steps per period (2 x 10^6 per simulated second). Below 0.1 ms, where the averaged PWM is
+    valid for the set, the calibration averages it too: one sub-step per 1 ms step."""
+    from smafinger.control import calibration
+    from smafinger.engine import run
+
+    real, substeps = run.simulate, []
+
+    def counted(*args, **kwargs):
+        spec = run.make_spec(*args, **{k: v for k, v in kwargs.items() if k != "engine"})
+        assert (spec.method, spec.dt_s, spec.pwm) == ("rk4", 1e-3, "averaged")  # else hours of edges
+        r = real(*args, **kwargs)
+        substeps.append(r.substeps)
+        return r
+
+    monkeypatch.setattr(run, "simulate", counted)
+    fast = calibration.calibrate(get("paper2010").replace(pwm_period_s=1e-6))
+    assert len(substeps) == len(calibration.CALIBRATION_TARGETS["joint"])
+    assert max(substeps) <= 1.01 * calibration.STEP_S / 1e-3  # a sub-step per step, not 2 x 10^6 per second
+    monkeypatch.setattr(run, "simulate", real)
+    resolved = calibration.calibrate(get("paper2010"))  # t_P = 1 ms: the PWM resolved, as it always was
+    assert fast.rms_error < 0.005 and abs(fast.c0 - resolved.c0) < 1e-4  # rad: the same map, near enough
+    # the paper's sets keep their calibrations; a hysteresis rule that follows the ripple keeps the PWM resolved
+    assert calibration.calibration_numerics(get("paper2010")).pwm == "exact"
+    assert calibration.calibration_numerics(get("authors2020").replace(pwm_period_s=1e-6)).pwm == "exact"

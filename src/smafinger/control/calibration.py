@@ -13,10 +13,19 @@ resistivity's temperature coefficients; the martensite fraction, through the pha
 resistivities; on the joint the series spring's elongation), so a map fitted to a slow sweep is
 off by degrees at the holds a controller makes. Fitted where it is used, it is right to tenths
 of a degree there (docs/controllers.md, "Self-sensing").
+
+The steps run at the reference numerics (RK4, 1 ms) with the PWM resolved at its edges: a
+sub-step ends at every period start and duty edge, 1.6 sub-steps per step at the paper's
+t_P = 1 ms, but up to 2 x 10^6 per simulated second at t_P = 1 us (there the 12 steps of 12 s
+took 189 s, for a run of 0.2 s). Below
+:data:`EXACT_PWM_MIN_PERIOD_S` they take the period-averaged PWM instead, where
+:func:`~smafinger.engine.numerics.long_step_refusal` finds it valid for the set
+(:func:`calibration_numerics`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,6 +43,10 @@ STEP_S = 12.0
 SETTLE_S = 6.0
 #: polynomial degree of Eq. (S1) in each wire's r_i
 DEGREE = 3
+#: the shortest PWM period the calibration resolves at its edges [s]: up to 20 edges per 1 ms
+#: step, about ten times the cost at the paper's t_P = 1 ms. Every shipped set is above it, so
+#: their calibrations are those made with the PWM resolved, as before this limit existed
+EXACT_PWM_MIN_PERIOD_S = 1e-4
 
 
 @dataclass(frozen=True)
@@ -109,18 +122,40 @@ def fit_calibration(wires: tuple[str, ...], q: np.ndarray, R_ohm: np.ndarray,
                                  rms_error=float(np.sqrt(np.mean(res**2))), max_error=float(np.max(np.abs(res))))
 
 
+def calibration_numerics(p: ParameterSet):
+    """The numerics of the calibration's steps on set ``p`` (an :class:`~smafinger.engine.numerics.Numerics`).
+
+    The reference (RK4, 1 ms, the PWM resolved at its edges), except that a PWM period below
+    :data:`EXACT_PWM_MIN_PERIOD_S` is averaged (RK4, 1 ms still) where the period-averaged PWM is
+    valid for a closed loop of the paper's PID on ``p``: where
+    :func:`~smafinger.engine.numerics.long_step_refusal` finds nothing against it, the rule a
+    run's default numerics follow (the averaged drive holds when t_P is far below the wire's
+    thermal time constant, :mod:`smafinger.engine.pwm`, and the hysteresis rule does not follow
+    the ripple it removes). Elsewhere the PWM stays resolved, up to two sub-steps per period, as in
+    the set's own runs at their defaults.
+    """
+    from ..engine.numerics import REFERENCE, long_step_refusal
+
+    if p.pwm_period_s < EXACT_PWM_MIN_PERIOD_S and long_step_refusal(p, None, STEP_S) is None:
+        return dataclasses.replace(REFERENCE, pwm="averaged")
+    return REFERENCE
+
+
 def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strategy: str = "independent",
               output_interval_s: float = 0.01) -> ResistanceCalibration:
     """Steps from rest to each target (user unit; default :data:`CALIBRATION_TARGETS`) with the paper's
-    PID and a position sensor, and the fit of Eq. (S1) to the settled samples."""
-    from ..engine.run import DEFAULT_DT_S, simulate
+    PID and a position sensor, and the fit of Eq. (S1) to the settled samples. The steps run at
+    :func:`calibration_numerics`: the PWM resolved, unless its period is below
+    :data:`EXACT_PWM_MIN_PERIOD_S` and averaging it is valid."""
+    from ..engine.run import simulate
 
     targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else targets
+    num = calibration_numerics(p)
     coord = f"{p.coordinate.name}_{p.coordinate.unit}"
     qs, Rs, R_ref = [], [], None
     for target in targets:
         r = simulate(p, strategy, f"0:{target:g}", t_end_s=STEP_S, output_interval_s=output_interval_s,
-                     dt_s=DEFAULT_DT_S, engine="compiled")  # the reference numerics: the PWM resolved
+                     method=num.method, dt_s=num.dt_s, pwm=num.pwm, engine="compiled")
         R = np.column_stack([r.signal(f"R_{w}_ohm") for w in p.wire_names])
         R_ref = R[0] if R_ref is None else R_ref
         keep = r.t >= SETTLE_S
