@@ -118,6 +118,28 @@ def test_a_stress_solve_that_fails_is_a_blow_up():
         assert np.all(np.isfinite(r.signal(name))), name
 
 
+def test_a_stress_root_above_the_first_bracket_is_found():
+    """With a martensite stiffer than the austenite (D_A = 1e8 Pa) the stress the strain implies
+    rises with the stress, both ends of the bracket [0, S(0)] were below the root, and the solve
+    returned -81 MPa: a wire in compression, one sample in a run (found by review)."""
+    from smafinger.model.build import build_model
+    from smafinger.model.hysteresis import BranchRecord
+    from smafinger.model.kinematics import wire_route
+    from smafinger.model.wire import _secant_stress, algebraic_stress, total_strain
+
+    p = get("linear-bias-spring").replace(D_A_Pa=1e8)
+    w = build_model(p).wires[0]
+    heating = BranchRecord(0, 1, 1.0, 1.0, 1.0, 72.55975492113824, 0.56893327483014, math.inf, 0.0, 1.0, 1.0, 1.0,
+                           23.0, 0.0, 0, 0)
+    T, eps = 76.79907094820038, total_strain(w, wire_route(w.route, 0.006241452827490246).path_m)
+    assert _secant_stress(w, eps, T, heating, 1e7)[0] > _secant_stress(w, eps, T, heating, 0.0)[0]  # S rises
+    sigma, xi, _ = algebraic_stress(w, eps, T, heating)
+    assert sigma > 0.0 and sigma == pytest.approx(_secant_stress(w, eps, T, heating, sigma)[0], rel=1e-8)
+    r = simulate(p, "independent", "0:0.0266,reach:-0.0099", t_end_s=2.0, controller="fuzzy-pid", hold_s=1.0,
+                 tol_m=0.002, method="rk4", dt_s=1e-3, pwm="exact")
+    assert float(np.min(r.sigma_wire_Pa)) >= 0.0
+
+
 def test_a_segment_that_never_starts_has_no_start_time():
     """Its start was -1e-9 s (the kernel's -1 marker times the tick), a time API users read as one
     (found by review)."""

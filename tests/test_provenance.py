@@ -182,11 +182,15 @@ def test_values_no_wire_has_are_warned_of():
     assert float(np.max(r.xi_wire)) > 1.2
     assert any(w.startswith("wire wire: xi = 1.2") and "outside [0, 1]" in w and "do not clip" in w
                for w in r.metrics["warnings"]), r.metrics["warnings"]
-    p = get("linear-bias-spring").replace(D_A_Pa=1e8)
-    r = simulate(p, "independent", "0:0.0266,reach:-0.0099", t_end_s=2.0, controller="fuzzy-pid", hold_s=1.0,
-                 tol_m=0.002, method="rk4", dt_s=1e-3, pwm="exact")
-    assert float(np.min(r.sigma_wire_Pa)) < -1e6
-    assert any("the wire pushes" in w for w in r.metrics["warnings"]), r.metrics["warnings"]
+    from types import SimpleNamespace
+
+    from smafinger.plausibility import COMPRESSION_PA, _impossible_wire
+
+    t = np.linspace(0.0, 1.0, 3)
+    for least, expected in ((COMPRESSION_PA * 0.99, 0), (COMPRESSION_PA * 1.01, 1)):
+        out = _impossible_wire(SimpleNamespace(column_names=[]), p, "wire", np.zeros(3),
+                               np.array([4e7, least, 4e7]), np.full(3, 50.0), t)
+        assert len(out) == expected and all("the wire pushes" in w for w in out)
 
 
 def test_a_temperature_nothing_can_reach_is_warned_of_at_its_threshold():

@@ -16,8 +16,10 @@ from .hysteresis import xi_on_branch
 def _secant_stress(wire, eps_total, T, branch, sigma):
     """S(sigma) = D_eq (eps - eps_R xi) with xi = xi(T, sigma): the stress the strain implies.
 
-    Returns (S, xi, spring elongation). S decreases as sigma grows (more stress, more martensite,
-    less elastic strain and a softer wire), so sigma = S(sigma) has exactly one root.
+    Returns (S, xi, spring elongation). With D_M <= D_A (NiTi's phases) S decreases as sigma
+    grows (more stress, more martensite, less elastic strain and a softer wire), so sigma =
+    S(sigma) has exactly one root. With a martensite stiffer than the austenite S can rise
+    (:func:`_bracketed_stress` widens its bracket); it never exceeds max(D_A, D_M) eps_total.
     """
     xi = xi_on_branch(branch, T, sigma, wire)[0]
     eps_el = eps_total - wire.eps_R * xi
@@ -29,12 +31,22 @@ def _secant_stress(wire, eps_total, T, branch, sigma):
 
 @njit(cache=True)
 def _bracketed_stress(wire, eps_total, T, branch):
-    """The root of sigma - S(sigma) by the Illinois method on [0, S(0)] (always converges)."""
+    """A root of sigma - S(sigma) by the Illinois method on [0, S(0)] (always converges).
+
+    Where S rises with sigma (a martensite stiffer than the austenite, :func:`_secant_stress`)
+    S(0) may be below the root: then the bracket's top is S's bound max(D_A, D_M) eps_total,
+    where sigma - S(sigma) >= 0 (found by review: with D_A = 1e8 Pa both ends were below the
+    root, and the method stepped outside them to -81 MPa, a wire in compression).
+    """
     lo, g_lo = 0.0, -_secant_stress(wire, eps_total, T, branch, 0.0)[0]
     if g_lo >= 0.0:
         return 0.0
     hi = -g_lo
     g_hi = hi - _secant_stress(wire, eps_total, T, branch, hi)[0]
+    if g_hi < 0.0:  # S(0) is below the root: S rose on the way
+        lo, g_lo = hi, g_hi
+        hi = max(wire.D_A_Pa, wire.D_M_Pa) * eps_total
+        g_hi = hi - _secant_stress(wire, eps_total, T, branch, hi)[0]
     side = 0
     x = hi
     for _ in range(100):
