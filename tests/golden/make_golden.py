@@ -48,7 +48,7 @@ def record(result) -> dict:
     return {
         "hash": {k: digest(v) for k, v in sig.items()},
         "n_samples": int(len(sig["t_s"])),
-        "segment_start_s": [float(x) for x in result.segment_start_s],
+        "segment_start_s": [None if np.isnan(x) else float(x) for x in result.segment_start_s],
         "segment_reached_s": [None if np.isnan(x) else float(x) for x in result.segment_reached_s],
         "substeps": int(result.substeps),
         "interlock_violations": int(result.interlock_violations),
