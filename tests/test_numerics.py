@@ -84,6 +84,8 @@ def test_the_default_is_the_long_step_only_where_it_was_validated(kw, want):
     ({"V_H_V": 16.0}, "0:1,3:0", 13.76, True),
     ({"V_H_V": 24.0}, "0:1,0.5:0", 5.94, True),
     ({"wire_length_m": 0.2}, "0:0.3,6:0", 3.14, True),
+    # the low level between pulses counts (found by review: V_L = 16 V took the long step)
+    ({"V_H_V": 16.0, "V_L_V": 16.0}, "0:0,3:0", 13.76, True),
 ])
 def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes, program, steps, refused):
     """The linear rig heated across its transformation band in a few long steps gave a false

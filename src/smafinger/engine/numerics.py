@@ -163,28 +163,45 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
 
 
 def _strongest_drive(params, program) -> tuple[float, bool]:
-    """(the strongest drive a wire of the run gets, as its period's root mean square [V or A];
-    whether it is a current): V_H in closed loop (any duty up to 100 %), the program's largest
-    step in open loop (a duty program's fraction of V_H at that duty)."""
+    """(the strongest drive a wire of the run gets, as its period's root mean square
+    (:func:`.pwm.averaged_drive`, with the low level V_L between pulses) [V or A]; whether it is
+    a current): in closed loop V_H or V_L (any duty from 0 to 100 %), in open loop the program's
+    strongest step or V_L (a duty program's steps are fractions of V_H; a current's low level is
+    0 A). The low level counted too (found by review: V_L = 16 V took the long step where 16 V
+    pulses at full duty did not)."""
+    from .pwm import averaged_drive
+
+    averaged_drive = getattr(averaged_drive, "py_func", averaged_drive)  # not compiled for this
+    low = params.V_L_V
     if program is None:
-        return params.V_H_V, False
+        return max(params.V_H_V, low), False
     values = np.column_stack(program.arrays()[1:])
     if program.kind == "duty":
-        return params.V_H_V * float(np.sqrt(values.max())), False
-    return float(values.max()), program.kind == "current"
+        return max(averaged_drive(params.V_H_V, low, 100.0 * float(d)) for d in np.unique(values)), False
+    if program.kind == "current":
+        return float(values.max()), True
+    return max(float(values.max()), low), False
 
 
 def _fast_transformation(params, program) -> str | None:
     """Why the transformation is too fast for the long step (None: it is not): the wire heats
     across its band A_S0 to A_F0 in fewer than :data:`MIN_BAND_STEPS` long steps at the run's
-    strongest drive (Eq. 11 at A_S0 with the heating coefficients: its fastest heating there)."""
+    strongest drive (Eq. 11 at A_S0 with the heating coefficients, no radiation: its fastest
+    heating there)."""
+    from ..model import heat
     from ..model.build import build_model
-    from ..model.heat import wire_temperature_rate
+
+    def plain(f):  # the compiled function's Python body: called here, it is not compiled (0.6 s a record type)
+        return getattr(f, "py_func", f)
 
     drive, current = _strongest_drive(params, program)
     model = build_model(params)
     wire = model.wires[0]  # every wire has the set's thermal fields
-    rate = wire_temperature_rate(wire, params.A_S0_C, params.T_amb_C, drive, True, current, model.options)
+    T = params.A_S0_C  # Eq. (11) there, the heating coefficients, to the ambient (radiation, if any, left out)
+    P = plain(heat.joule_power_per_m)(wire, drive, current, model.options.joule_heating)
+    h = plain(heat.convection_coefficient)(T, wire.h0_heating_W_m2K, wire.h2_heating_W_m2K3)
+    rate = plain(heat.heat_balance)(T, P, h, wire.T_amb_C, wire.mass_per_length_kg_m, wire.specific_heat_J_kgK,
+                                    wire.perimeter_m)
     band = params.A_F0_C - params.A_S0_C
     if rate > 0.0 and band < MIN_BAND_STEPS * LONG_STEP_DT_S * rate:
         unit = "A" if current else "V"
