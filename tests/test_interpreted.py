@@ -206,3 +206,16 @@ def test_a_fresh_install_answers_interpreted_then_compiles_in_the_background(fre
     assert [s["engine"] for s in summaries] == ["interpreted", "compiled"]
     assert summaries[0]["segments"][0]["reached_s"] == pytest.approx(summaries[1]["segments"][0]["reached_s"],
                                                                       abs=1e-9)
+
+
+def test_a_run_s_metrics_with_numba_s_jit_off():
+    """The plausibility check called a compiled function's ``py_func``, which does not exist with
+    numba's JIT off: every run's metrics failed there (found by review)."""
+    code = ("from smafinger import simulate; from smafinger.parameters import get\n"
+            "r = simulate(get('linear-bias-spring').replace(wire_diameter_m=0.25e-3), 'open-loop', voltage='0:0.3,0.2:0',"
+            " drive='duty', t_end_s=0.3)\n"
+            "print(sum(w.startswith('resistance_ohm_per_m') for w in r.metrics['warnings']))")
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "1"

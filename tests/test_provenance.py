@@ -188,7 +188,7 @@ def test_values_no_wire_has_are_warned_of():
 
     t = np.linspace(0.0, 1.0, 3)
     for least, expected in ((COMPRESSION_PA * 0.99, 0), (COMPRESSION_PA * 1.01, 1)):
-        out = _impossible_wire(SimpleNamespace(column_names=[]), p, "wire", np.zeros(3),
+        out = _impossible_wire(SimpleNamespace(signal=lambda name: np.full(3, 30.0)), p, "wire", np.zeros(3),
                                np.array([4e7, least, 4e7]), np.full(3, 50.0), t)
         assert len(out) == expected and all("the wire pushes" in w for w in out)
 
@@ -205,7 +205,7 @@ def test_a_temperature_nothing_can_reach_is_warned_of_at_its_threshold():
                                            (floor + 2.0, floor - 0.01, 1), (floor - 0.01, floor - 2.0, 2)):
         T = np.array([p.T_init_C, 60.0, wire_min, 40.0, 30.0])
         casing = np.array([p.T_amb_C, 25.0, casing_min, 23.0, 22.5])
-        result = SimpleNamespace(column_names=["T_casing_upper_C"], signal=lambda name, c=casing: c)
+        result = SimpleNamespace(signal=lambda name, c=casing: c)
         out = _impossible_wire(result, p, "upper", np.zeros(5), np.zeros(5), T, t)
         assert len(out) == expected, (wire_min, casing_min, out)
         assert all("numerical instability" in w for w in out)

@@ -85,7 +85,9 @@ WC = WireColumns(*range(len(WIRE_FIELDS)))
 #: what a run's metrics and plausibility checks read (``results.compute_metrics``): all a sweep's
 #: table needs. A run made with ``record="metrics"`` records these signals alone (the kernel
 #: writes 12 of the joint's 35 values a sample); a test checks that its metrics are the same.
-METRIC_FIELDS = ("t", "q", "T", "xi", "sigma", "electrical", "heat")
+#: (the casing temperature for the plausibility check's casing warning: a sweep's rows give the same
+#: warnings as simulate, found by review)
+METRIC_FIELDS = ("t", "q", "T", "xi", "sigma", "electrical", "heat", "T_case")
 #: what a run records: every signal, or the :data:`METRIC_FIELDS`
 RECORD = ("all", "metrics")
 
@@ -175,6 +177,7 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
         wo[w, WC.sigma, i] = wa.sigma_Pa
         wo[w, WC.electrical, i] = ws.electrical_J
         wo[w, WC.heat, i] = ws.heat_J
+        wo[w, WC.T_case, i] = ws.T_case_C
         if not every_signal:
             continue
         wo[w, WC.force, i] = wa.force_N
@@ -182,7 +185,6 @@ def record_sample(mo, wo, i, t_s, state, aux, q_target, segment, stuck, cmds, dr
         wo[w, WC.spring, i] = wa.spring_m
         wo[w, WC.V, i] = drives[w]
         wo[w, WC.duty, i] = cmds[w].duty
-        wo[w, WC.T_case, i] = ws.T_case_C
         wo[w, WC.enabled, i] = 1.0 if cmds[w].enabled else 0.0
         wo[w, WC.heating, i] = 1.0 if cmds[w].heating else 0.0
         strain = wire_strain(wires[w], geom.routes[w][0], wa.spring_m)
