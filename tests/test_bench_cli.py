@@ -273,3 +273,26 @@ def test_ctrl_c_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch):
     assert r.exit_code == 130
     assert f"interrupted (Ctrl-C) after the outputs were written to {out}" in r.output
     assert (out / "goals.json").exists()
+
+
+def test_ctrl_c_in_the_teardown_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch):
+    """A Ctrl-C while the pool and the progress display closed, after the files had been moved in,
+    said "no output was written" (found by review)."""
+    import contextlib
+
+    import smafinger.cli.bench as cli_bench
+
+    real = cli_bench.progress_display
+
+    @contextlib.contextmanager
+    def interrupted_on_close(progress):
+        with real(progress) as display:
+            yield display
+        raise KeyboardInterrupt  # the teardown, once the body (the runs and the files) is done
+
+    monkeypatch.setattr(cli_bench, "progress_display", interrupted_on_close)
+    out = tmp_path / "out"
+    r = runner.invoke(app, [*QUICK, "--no-figures", "--out", str(out)])
+    assert r.exit_code == 130
+    assert f"interrupted (Ctrl-C) after the outputs were written to {out}" in r.output
+    assert (out / "goals.json").exists()

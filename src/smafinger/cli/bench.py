@@ -87,20 +87,26 @@ def bench_controllers(
     if not tasks:
         _fail("--mechanism/--task/--quick: no task left to run")
     labels = tuple(controller or (QUICK_CONTROLLERS if quick else BENCH_CONTROLLERS))
-    # one pool for the runs and the figures; its workers start while the controllers are made
-    with progress_display(progress) as display, make_pool(workers) as pool:
-        try:
-            res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers, report=_say, pool=pool,
-                            on_progress=display.counter("bench-controllers", "runs"))
-        except BatchError as exc:
-            _fail(str(exc), code=1)
-        # all or nothing: staged inside --out, then replacing what an earlier bench wrote there
-        write_report(res, tasks, out, figures=figures, pool=pool, on_progress=display.counter("figures", "figures"))
+    written = False  # the outputs in place: a Ctrl-C from then on (the pool's and the display's
+    # teardown, the printing) is not "no output was written" (found by review)
     try:
+        # one pool for the runs and the figures; its workers start while the controllers are made
+        with progress_display(progress) as display, make_pool(workers) as pool:
+            try:
+                res = run_bench(tasks, labels, tuple(strategy or STRATEGIES), workers, report=_say, pool=pool,
+                                on_progress=display.counter("bench-controllers", "runs"))
+            except BatchError as exc:
+                _fail(str(exc), code=1)
+            # all or nothing: staged inside --out, then replacing what an earlier bench wrote there
+            write_report(res, tasks, out, figures=figures, pool=pool,
+                         on_progress=display.counter("figures", "figures"))
+            written = True
         print(markdown(res, tasks))
         _say(f"written to {out}")
-    except KeyboardInterrupt:  # the outputs are in place: not "no output was written"
-        raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
+    except KeyboardInterrupt:
+        if written:
+            raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
+        raise
 
 
 def tune(

@@ -36,12 +36,16 @@ def reproduce(
     if workers is not None and workers < 1:
         raise UsageError(f"--workers {workers}: must be >= 1")
     check_out_dir(out)  # before any run: a file, a missing parent, a folder holding other files
-    with progress_display(progress) as display:
-        res = run(out, only=only, workers=workers, progress=display, investigate=investigate)
+    res = None  # set once the outputs are in place: a Ctrl-C from then on (the display's teardown,
+    # the printing) is not "no output was written" (found by review)
     try:
+        with progress_display(progress) as display:
+            res = run(out, only=only, workers=workers, progress=display, investigate=investigate)
         _print(res)
-    except KeyboardInterrupt:  # the outputs are in place: not "no output was written"
-        raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
+    except KeyboardInterrupt:
+        if res is not None:
+            raise KeyboardInterrupt(f"interrupted (Ctrl-C) after the outputs were written to {out}") from None
+        raise
     if res.failed:
         raise WorkFailed(f"{len(res.failed)} run(s) failed: {', '.join(res.failed)} (see summary.json)")
 
