@@ -159,6 +159,32 @@ def test_parquet_time_in_ms_and_a_repeated_time(tmp_path):
 
 
 # ---- MATLAB ----------------------------------------------------------------------------------
+@pytest.mark.parametrize("oned_as", ["row", "column"])
+def test_mat_structure_with_time_of_1d_arrays(tmp_path, oned_as):
+    """scipy.io.savemat writes a 1-D array as a 1 x N row: a Structure With Time made of 1-D
+    arrays was read as N one-sample signals, and the message listed all of them (20 kB; found
+    by review)."""
+    t = np.linspace(0.0, 2.0, 901)
+    f = tmp_path / "rows.mat"
+    sio.savemat(f, {"duty": {"time": t, "signals": {"values": np.full(t.size, 0.25)}},
+                    "position_m": {"time": t, "signals": {"values": 1e-3 * t}}}, oned_as=oned_as)
+    rec = read_recording(f)
+    np.testing.assert_array_equal(rec.input.t_s, t)
+    np.testing.assert_array_equal(rec.input.values, np.full(t.size, 0.25))
+    np.testing.assert_array_equal(rec.output.values, 1e-3 * t)
+
+
+def test_a_refusal_lists_a_dozen_names_at_most(tmp_path):
+    from smafinger.recordings.reader import LISTED_NAMES
+
+    t = np.linspace(0.0, 1.0, 11)
+    f = tmp_path / "many.mat"
+    sio.savemat(f, {"tout": t[:, None], **{f"sig{k:03d}": t[:, None] for k in range(200)}})
+    msg = refusal(f)
+    listed = msg.split("(variables: ")[1].split(" and ")[0].split(", ")
+    assert len(listed) == LISTED_NAMES and "and 189 more" in msg and len(msg) < 1000  # 201 variables
+
+
 @pytest.mark.parametrize("compress", [False, True])
 @pytest.mark.parametrize("oned_as", ["row", "column"])
 def test_mat_simulink_several_signals_at_different_rates(tmp_path, compress, oned_as):

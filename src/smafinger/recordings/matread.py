@@ -174,17 +174,21 @@ def _vector(where, v, variables, time_var: Source) -> _Entry:
 def _simulink(path, var, s, meta):
     where = f"{path}: variable {var!r}"
     columns = []  # (values, label, blockName)
+    t, t_error = _time(s)
     for sig in _struct_list(s.signals):
         vals = _unwrap(getattr(sig, "values", None))
         if not (isinstance(vals, np.ndarray) and vals.dtype.kind in "iuf" and vals.ndim == 2):
             shape = getattr(vals, "shape", None)
             return [(var, _Entry(where, error=f"signals.values is not a numeric N x K matrix (shape {shape})"))]
+        if vals.shape[0] == 1 and vals.shape[1] > 1 and t is not None and t.size == vals.shape[1]:
+            # a 1 x N row as long as the time: one signal (scipy.io.savemat writes a 1-D array as a
+            # row; read as N one-sample signals it was "no input variable"; found by review)
+            vals = vals.T
         label, block = _text(getattr(sig, "label", "")), _text(getattr(sig, "blockName", ""))
         columns += [(vals[:, j].astype(np.float64), label, block) for j in range(vals.shape[1])]
     if not columns:
         return [(var, _Entry(where, error="has no signals (signals is empty)"))]
     names = [var] if len(columns) == 1 else [f"{var}({k})" for k in range(1, len(columns) + 1)]
-    t, t_error = _time(s)
     out = []
     for name, (v, label, block) in zip(names, columns):
         w = f"{path}: variable {name!r}"

@@ -73,11 +73,22 @@ def _open(path: Path, fmt: str, smap: SignalMap):
     return open_mat(path, smap)
 
 
+#: how many names a message lists (a file of a thousand variables gave a 20 kB line; found by review)
+LISTED_NAMES = 12
+
+
+def _listing(names) -> str:
+    """The names, quoted, at most :data:`LISTED_NAMES` of them (then how many more)."""
+    names = list(names)
+    shown = ", ".join(map(repr, names[:LISTED_NAMES])) or "none"
+    return shown + (f" and {len(names) - LISTED_NAMES} more" if len(names) > LISTED_NAMES else "")
+
+
 def _choose(source_file, smap: SignalMap) -> dict[str, str]:
     """canonical signal name -> role (``input``, ``output``, ``T_C``, ``resistance_ohm``)."""
     names = set(source_file.names)
     what, path = source_file.what, source_file.path
-    listing = ", ".join(map(repr, source_file.names)) or "none"
+    listing = _listing(source_file.names)
     for name, src in smap.entries:
         if name != TIME and src.name not in names:
             raise RecordingError(f"{path}: mapping {name}={src.to_text()}: no {what} {src.name!r} "
