@@ -147,3 +147,76 @@ def test_a_fit_stopped_by_its_evaluation_limit_says_so(files, tmp_path):
     assert "warning: the local fit stopped at its limit of 2 evaluations (--max-nfev)" in r.output
     assert any("limit of 2 evaluations" in n for n in json.loads((tmp_path / "r.json").read_text())["fit"]["notes"])
     assert "--max-nfev), not at a minimum" not in invoke(*args, "--max-nfev", "60").output
+
+
+def test_a_held_out_run_logged_after_its_drive_came_on_is_refused(files, tmp_path):
+    """Its offset is measured on the samples before the drive (the model at rest there); with the
+    output logged only from 0.5 s, the drive on at 0.2 s, the first sample was taken as at rest
+    and the offset came out wrong, silently (found by review). Now a refusal naming the file and
+    the ways out; with --offset none (a calibrated sensor) the run is predicted."""
+    import pandas as pd
+
+    df = pd.read_csv(files / "a.csv", dtype=str, keep_default_na=False)
+    df.loc[df.t_s.astype(float) < 0.5, "position_m"] = ""
+    df.to_csv(tmp_path / "late.csv", index=False)
+    args = ["--params", "linear-bias-spring", "--validate", tmp_path / "late.csv", "--workers", "1",
+            "--report", tmp_path / "r.json"]
+    refused(invoke(*args), f"{tmp_path / 'late.csv'}: no output sample before the drive first turns on "
+                           "(at t = 0.2 s; the output starts at 0.5 s), so its sensor offset cannot be measured")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["late.csv"]
+    r = invoke(*args, "--offset", "none")
+    assert r.exit_code == 0, r.output
+    f = json.loads((tmp_path / "r.json").read_text())["files"][0]
+    assert f["offset_method"] == "none" and f["baseline_samples"] == 0 and f["noise_m"] is None
+
+
+def test_fitted_runs_without_a_baseline_are_judged_by_their_residuals(tmp_path):
+    """Runs whose drive is on from the first sample measure no sensor noise, so the check of the
+    RMS against the noise was skipped: a fit at 1.9 mm RMS on runs with 30 um of noise passed
+    with no word, every run's residuals at rho 0.995 (found by review). Now that the misfit could
+    not be judged is said, and residuals that are a slow curve (rho > 0.9) are warned about, on the
+    console and in the report's notes; a fit that reaches the noise gets only the first note."""
+    truth = LINEAR.replace(A_S0_C=72.0, A_F0_C=83.0, h0_cooling_W_m2K=35.0)
+    truth.save(tmp_path / "truth.toml")
+    bs.write_csv(tmp_path / "on1.csv", bs.open_loop_run(truth, "0:0.4,2:0", 4.0, noise=2e-5, offset=1e-3, seed=1))
+    bs.write_csv(tmp_path / "on2.csv", bs.open_loop_run(truth, "0:0.3,1:0.5,2.5:0", 4.0, noise=2e-5, seed=2))
+    runs = ["--fit", tmp_path / "on1.csv", "--fit", tmp_path / "on2.csv", "--free", "eps_R", "--max-nfev", "5",
+            "--workers", "1", "--report", tmp_path / "r.json"]
+    unjudged = "warning: the fitted runs' RMS ("
+    slow = "warning: the fitted runs' residuals are a slow curve, not noise (lag-1 autocorrelation 0.99"
+
+    bad = invoke("--params", "linear-bias-spring", *runs, "--budget", "8")  # eps_R cannot make up for the rest
+    assert bad.exit_code == 0, bad.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["summary"]["fit"]["rms_over_noise"] is None and rep["summary"]["fit"]["rms_m"] > 1e-3
+    assert unjudged in bad.output and "could not be judged against the sensor noise" in bad.output
+    assert slow in bad.output and "on on1.csv" in bad.output and "above 0.9): the model misses the data" in bad.output
+    assert [n.startswith(("the fitted runs' RMS (", "the fitted runs' residuals are a slow curve"))
+            for n in rep["fit"]["notes"]] == [True, True]
+
+    good = invoke("--params", tmp_path / "truth.toml", *runs, "--budget", "0")
+    assert good.exit_code == 0, good.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["summary"]["fit"]["rms_m"] < 3e-5 and max(rep["fit"]["lag1_autocorrelation"].values()) < 0.5
+    assert unjudged in good.output and "slow curve" not in good.output and len(rep["fit"]["notes"]) == 1
+
+
+def test_a_parameter_the_runs_barely_see_is_not_determined(tmp_path):
+    """A step whose wire cools too little to reach the martensite band hardly sees M_S0_C and
+    M_F0_C: they got standard errors of 3e9 and 2.5e10 degC on 30 degC bounds, rank_deficient
+    false and no warning (found by review). A standard error wider than the bounds now counts as
+    not determined: infinite (null in the report), rank_deficient, and a warning naming them."""
+    truth = LINEAR.replace(A_S0_C=71.66, M_S0_C=55.7, eps_R=0.013, h0_heating_W_m2K=40.6, h0_cooling_W_m2K=32.3)
+    truth.save(tmp_path / "truth.toml")
+    bs.write_csv(tmp_path / "step.csv", bs.open_loop_run(truth, "0:0,0.5:0.25,5:0", 9.0, noise=3e-5, offset=1.2e-3,
+                                                         seed=3))
+    r = invoke("--params", tmp_path / "truth.toml", "--fit", tmp_path / "step.csv", "--free", "A_S0_C", "--free",
+               "M_S0_C", "--free", "M_F0_C", "--budget", "0", "--max-nfev", "10", "--workers", "1",
+               "--report", tmp_path / "r.json")
+    assert r.exit_code == 0, r.output
+    fit = json.loads((tmp_path / "r.json").read_text())["fit"]
+    assert fit["stderr"]["M_S0_C"] is None and fit["stderr"]["M_F0_C"] is None
+    assert fit["stderr_white"]["M_S0_C"] is None and fit["rank_deficient"] is True
+    assert 0 < fit["stderr"]["A_S0_C"] < 0.1  # the heating pins the austenite start
+    assert "warning: not determined by these runs: M_S0_C, M_F0_C (" in r.output
+    assert any(n.startswith("not determined by these runs: M_S0_C, M_F0_C") for n in fit["notes"])

@@ -255,3 +255,62 @@ def test_a_run_whose_drive_is_on_from_its_first_sample_has_no_baseline_but_that_
     assert late.baseline_offset(p) == pytest.approx(1.2e-3, abs=2e-4)
     whole = load_open_loop(data / "bench_step.csv", None, "validate", p)
     assert whole.baseline.sum() > 10 and whole.baseline_noise() < 1e-4
+
+
+def _blank_output_before(path, t_s: float, column: str = "position_m") -> None:
+    """The file's output cells before ``t_s`` emptied: a logger started late."""
+    import pandas as pd
+
+    df = pd.read_csv(path, dtype=str, keep_default_na=False)
+    df.loc[df.t_s.astype(float) < t_s, column] = ""
+    df.to_csv(path, index=False)
+
+
+def test_an_output_logged_only_after_the_drive_came_on_has_no_baseline(tmp_path):
+    """The first output sample counted as at rest however late it came: a held-out run whose
+    position was logged from 2.3 s after its drive came on got a "baseline" offset of 0.69 mm
+    (truth 0.4), silently (found by review). Now it has no baseline, and measuring its offset is
+    refused, naming the file, both times as in the file and what to do instead."""
+    run = bs.open_loop_run(LINEAR, "0:0,0.3:0.4,1.5:0", 2.0, noise=2e-5, offset=1e-3, seed=4)
+    bs.write_csv(tmp_path / "late.csv", run)
+    _blank_output_before(tmp_path / "late.csv", 0.5)
+    late = load_open_loop(tmp_path / "late.csv", None, "validate", LINEAR)
+    assert late.samples.t_s[0] == pytest.approx(0.5) and late.rest_end_s == pytest.approx(0.3)
+    assert late.baseline.sum() == 0 and late.baseline_noise() is None
+    with pytest.raises(BenchRunError, match=r"late.csv: no output sample before the drive first turns on \(at "
+                                            r"t = 0.3 s; the output starts at 0.5 s\).*--offset none.*--fit"):
+        late.baseline_offset(LINEAR)
+    bs.write_csv(tmp_path / "whole.csv", run)  # logged from the start: 31 samples at rest until 0.3 s
+    assert load_open_loop(tmp_path / "whole.csv", None, "validate", LINEAR).baseline.sum() == 31
+
+
+def test_a_replay_whose_output_starts_after_the_reference_moved_is_refused(tmp_path):
+    """A closed-loop run's reference offset is measured on its baseline too: with the output
+    logged only after the reference first changed there is none (it took the first sample)."""
+    rig = RigController(K_P=20.0, K_V=0.5, K_I=0.0)
+    run = bs.closed_loop_run(LINEAR, "0:0,0.3:0.004", rig, 1.0, noise=2e-5, offset=1e-3, seed=3)
+    bs.write_csv(tmp_path / "track.csv", run)
+    _blank_output_before(tmp_path / "track.csv", 0.5)
+    with pytest.raises(BenchRunError, match=r"track.csv: no output sample before the reference first changes "
+                                            r"\(at t = 0.3 s; the output starts at 0.5 s\).*--offset none"):
+        load_closed_loop(tmp_path / "track.csv", None, LINEAR, rig)
+    calibrated = load_closed_loop(tmp_path / "track.csv", None, LINEAR, rig, offset=False)
+    assert calibrated.baseline.sum() == 0 and calibrated.reference_offset == 0.0
+
+
+def test_a_standard_error_wider_than_the_bounds_is_not_determined():
+    """null_directions scales every column of J to unit size, so a column a billion times smaller
+    than the others (a temperature band a run barely reaches) passed as identified, with a finite
+    standard error of 1e9 or so: M_S0_C = 55.7 +- 3.1e9 on bounds 40.7..70.7, no warning (found by
+    review). Such a quantity is now marked not determined, as a null direction is."""
+    from smafinger.analysis.fit_uncertainty import mark_undetermined
+
+    t = np.linspace(0.0, 1.0, 50)
+    J = np.column_stack([np.ones(50), 1e-9 * np.cos(7.0 * t), t])
+    cov = covariance(J, np.random.default_rng(0).standard_normal(50), [slice(0, 50)])
+    assert not cov.rank_deficient and np.isfinite(cov.stderr).all() and cov.stderr[1] > 1e6
+    marked = mark_undetermined(cov, [np.inf, 30.0, 30.0])
+    assert marked.rank_deficient and marked.undetermined.tolist() == [False, True, False]
+    assert math.isinf(marked.stderr[1]) and math.isinf(marked.stderr_white[1])
+    np.testing.assert_array_equal(marked.stderr[[0, 2]], cov.stderr[[0, 2]])
+    assert mark_undetermined(cov, [np.inf, 1e12, 30.0]) is cov  # within its range: determined

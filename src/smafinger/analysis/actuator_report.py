@@ -5,8 +5,9 @@ of its position (or angle) sensor is:
 
 - ``fitted``: a fitted run's offset from the fit (profiled least squares, with its stderr);
 - ``baseline``: a held-out run's offset measured on its own samples recorded while the model
-  is still at rest (before the drive or reference first leaves its rest value), with no use of
-  the model's prediction: a held-out run is predicted, not fitted;
+  is still at rest (before the drive or reference first leaves its rest value, or at that
+  instant), with no use of the model's prediction: a held-out run is predicted, not fitted (one
+  with no such sample is refused: :meth:`~.bench_runs.BenchRun.check_baseline`);
 - ``none``: the sensor is taken as calibrated (``--offset none``).
 
 Each run's ``rms_offset_fitted_*`` also gives the RMS error with the offset that suits the run
@@ -26,12 +27,18 @@ import numpy as np
 from ..engine.batch import iter_batch
 from ..parameters import ParameterSet
 from .actuator_eval import coordinate_signal
-from .bench_runs import BenchRun, coordinate_column, output_si_name
+from .bench_runs import MIN_NOISE_SAMPLES, BenchRun, coordinate_column, output_si_name
 from .fit_uncertainty import lag1_autocorrelation
 
 #: SI output -> (factor to display units, display unit, axis label)
 DISPLAY = {"position_m": (1e3, "mm", "Position"), "theta_rad": (180.0 / math.pi, "deg", "Angle")}
 OFFSET_POLICIES = ("per-run", "none")
+#: warn when the fitted runs' RMS exceeds their baseline noise by this factor
+MISFIT_WARN = 1.5
+#: with no noise measured, warn when a fitted run's residuals have a lag-1 autocorrelation above
+#: this: a slow curve, not noise (rho of white noise is near 0; a smooth misfit sampled densely
+#: is near 1, and its sum of squares says nothing by itself about the sensor)
+RHO_MISFIT = 0.9
 
 
 def unit_suffix(p: ParameterSet) -> str:
@@ -161,6 +168,37 @@ def role_summary(predictions: Sequence[RunPrediction], p: ParameterSet) -> dict:
                       "n_samples": int(r.size), f"noise_{u}": pooled,
                       "rms_over_noise": rms / pooled if pooled else None}
     return out
+
+
+def misfit_notes(predictions: Sequence[RunPrediction], p: ParameterSet) -> list[str]:
+    """Whether the fitted runs are predicted to their noise: the report's and the console's notes.
+
+    With a baseline noise measured (:func:`role_summary`), the RMS is judged against it
+    (:data:`MISFIT_WARN`). Without (no fitted run has :data:`~.bench_runs.MIN_NOISE_SAMPLES`
+    samples at rest before its drive), that is said, and the residuals' shape judges instead:
+    a fitted run whose residuals have a lag-1 autocorrelation above :data:`RHO_MISFIT` is a
+    curve the model misses, not noise. (With a noise measured, rho is not used: a sensor's own
+    filtering also makes its noise slow.)
+    """
+    fit = role_summary(predictions, p).get("fit")
+    if not fit or fit.get("failed"):
+        return []
+    factor, unit, _ = DISPLAY[output_si_name(p)]
+    advice = "a local minimum (try a larger --budget or another --seed) or a model error"
+    ratio = fit["rms_over_noise"]
+    if ratio is not None:
+        return [f"the fitted runs' RMS is {ratio:.2g} times the sensor noise measured before the drive: "
+                f"{advice}"] if ratio > MISFIT_WARN else []
+    notes = [f"the fitted runs' RMS ({factor * fit[f'rms_{unit_suffix(p)}']:.4g} {unit}) could not be judged "
+             f"against the sensor noise: no fitted run has {MIN_NOISE_SAMPLES} or more samples at rest before its "
+             "drive turns on, which measure it (record half a second before switching the drive on)"]
+    rho = [(Path(pr.run.file).name, pr.stats()["lag1"]) for pr in predictions
+           if (pr.run.role, pr.run.mode) == SUMMARY_GROUPS["fit"]]
+    slow = [f"{r:.3g} on {name}" for name, r in rho if r > RHO_MISFIT]
+    if slow:
+        notes.append(f"the fitted runs' residuals are a slow curve, not noise (lag-1 autocorrelation "
+                     f"{', '.join(slow)}; above {RHO_MISFIT:g}): the model misses the data: {advice}")
+    return notes
 
 
 def figure_names(predictions: Sequence[RunPrediction], suffix: str = ".png") -> dict[str, str]:

@@ -17,8 +17,9 @@ without interpolation.
 
 The measured output is the mechanism's coordinate plus a sensor offset per run. The model
 starts every run at rest at its initial coordinate, so the samples recorded before the drive
-(or the reference) first leaves its rest value measure that offset directly
-(:attr:`BenchRun.baseline`).
+(or the reference) first leaves its rest value, or at that instant, measure that offset directly
+(:attr:`BenchRun.baseline`). A run whose output was first sampled after that has no baseline:
+its offset cannot be measured (:meth:`BenchRun.baseline_offset` refuses it).
 """
 
 from __future__ import annotations
@@ -139,10 +140,13 @@ class BenchRun:
         Closed loop: (times, values) of the reference as recorded (SI).
     controller : RigController or None
     baseline : ndarray of bool
-        Output samples recorded while the model is still at rest (before the drive or the
-        reference first leaves its rest value; at least the first sample).
+        Output samples recorded while the model is still at rest: at or before
+        :attr:`rest_end_s`. No sample if the output was first sampled later.
     reference_offset : float
         Closed loop: the sensor offset subtracted from the reference (measured on the baseline).
+    rest_end_s : float
+        When the drive (open loop) or the reference (closed loop) first leaves its rest value
+        [s from the run's start]; 0 for a drive on from its first sample, inf if it never does.
     """
 
     file: str
@@ -158,14 +162,47 @@ class BenchRun:
     reference: tuple[np.ndarray, np.ndarray] | None = None
     controller: RigController | None = None
     reference_offset: float = 0.0
+    rest_end_s: float = math.inf
 
     @property
     def n_samples(self) -> int:
         return int(self.samples.values.size)
 
     def baseline_offset(self, p: ParameterSet) -> float:
-        """Sensor offset measured on the baseline: its mean minus the rest coordinate [SI]."""
+        """Sensor offset measured on the baseline: its mean minus the rest coordinate [SI].
+
+        Raises
+        ------
+        BenchRunError
+            No output sample is on the baseline (see :meth:`check_baseline`).
+        """
+        self.check_baseline()
         return float(np.mean(self.samples.values[self.baseline])) - rest_coordinate_si(p)
+
+    def check_baseline(self) -> None:
+        """Refuse a run whose output was first sampled after the drive (or the reference) left
+        its rest value: no sample shows the model at rest, so the sensor offset cannot be
+        measured, and any sample taken for it would carry part of the motion.
+
+        Raises
+        ------
+        BenchRunError
+            One line naming the file, both times (as in the file) and what to do instead.
+        """
+        if self.baseline.any():
+            return
+        t0 = float(self.recording.meta.get("time_origin_s", 0.0))
+        if self.mode == "open-loop":
+            what, fix = "the drive first turns on", ("record the output from before the drive turns on, give "
+                                                     "--offset none (a calibrated sensor), or fit the run (--fit: "
+                                                     "its offset is fitted)")
+        else:
+            what, fix = "the reference first changes", ("record the output from before the reference changes, or "
+                                                        "give --offset none (a calibrated sensor: the reference is "
+                                                        "the target)")
+        raise BenchRunError(f"{self.file}: no output sample before {what} (at t = {self.rest_end_s + t0:.6g} s; "
+                            f"the output starts at {float(self.recording.output.t_s[0]) + t0:.6g} s), so its sensor "
+                            f"offset cannot be measured: {fix}")
 
     def baseline_noise(self) -> float | None:
         """Standard deviation of the baseline samples (the sensor's noise while at rest), or
@@ -215,9 +252,8 @@ IDLE_FRACTION = 0.05
 
 
 def _rest_mask(t_out: np.ndarray, t_rest: float) -> np.ndarray:
-    mask = t_out <= t_rest + 1e-9
-    mask[0] = True
-    return mask
+    """The output samples at or before ``t_rest`` (the model is at rest until then, and at it)."""
+    return t_out <= t_rest + 1e-9
 
 
 def drive_program(rec: Recording, p: ParameterSet, wire: str | None = None) -> VoltageProgram:
@@ -255,14 +291,15 @@ def load_open_loop(path, mapping, role: str, p: ParameterSet, wire: str | None =
     interval, t_end, samples = _grid(rec, "input", dt_s)
     # the baseline (at rest: the offset and the noise are measured there) lasts until the input
     # first changes, if it starts idle (off, or at most IDLE_FRACTION of its largest value: a
-    # sensing current); a run whose drive is on from its first sample has none but that sample
-    # (its whole heating counted as rest gave a 5.5 mm offset and 7.5 mm of "noise")
+    # sensing current); a run whose drive is on from its first sample has none but an output
+    # sample at that instant (its whole heating counted as rest gave a 5.5 mm offset and 7.5 mm
+    # of "noise"); an output first sampled after the drive came on has none at all
     u = rec.input.values
     on = np.flatnonzero(u != u[0])
     idle = abs(float(u[0])) <= IDLE_FRACTION * float(np.max(np.abs(u)))
-    t_rest = (float(rec.input.t_s[on[0]]) if on.size else math.inf) if idle else -math.inf
+    t_rest = (float(rec.input.t_s[on[0]]) if on.size else math.inf) if idle else float(rec.input.t_s[0])
     return BenchRun(str(path), role, "open-loop", rec, samples, interval, t_end,
-                    _rest_mask(rec.output.t_s, t_rest), program=drive_program(rec, p, wire))
+                    _rest_mask(rec.output.t_s, t_rest), program=drive_program(rec, p, wire), rest_end_s=t_rest)
 
 
 def load_closed_loop(path, mapping, p: ParameterSet, controller: RigController, reference: str | None = None,
@@ -272,8 +309,9 @@ def load_closed_loop(path, mapping, p: ParameterSet, controller: RigController, 
     ``reference`` is the reference column as ``NAME[*FACTOR]`` (default: ``position_ref_m`` or
     ``theta_ref_deg``), read from the same file with the same checks and units as the output.
     The reference is in the sensor's frame; the target is the reference minus the offset
-    measured on the baseline (the samples before the reference first changes), or the
-    reference itself with ``offset=False`` (a calibrated sensor).
+    measured on the baseline (the samples before the reference first changes, or at that
+    instant; a :class:`BenchRunError` if there are none), or the reference itself with
+    ``offset=False`` (a calibrated sensor).
 
     A closed loop can amplify small differences: where the PID drives the wire bang-bang
     through a steep transformation band, a target 1 um off can move a rise by tens of
@@ -290,11 +328,12 @@ def load_closed_loop(path, mapping, p: ParameterSet, controller: RigController, 
     interval, t_end, samples = _grid(rec, "reference", dt_s)
     t_ref, v_ref = ref.t_s - t0, ref.values
     moved = np.flatnonzero(v_ref != v_ref[0])
-    baseline = _rest_mask(rec.output.t_s, float(t_ref[moved[0]]) if moved.size else math.inf)
-    offset = float(np.mean(samples.values[baseline])) - rest_coordinate_si(p) if offset else 0.0
-    run = BenchRun(str(path), "validate", "closed-loop", rec, samples, interval, t_end, baseline,
-                   reference=(t_ref, v_ref), controller=controller, reference_offset=offset)
-    return replace(run, profile=reference_profile(t_ref, v_ref - offset, p))
+    t_rest = float(t_ref[moved[0]]) if moved.size else math.inf
+    run = BenchRun(str(path), "validate", "closed-loop", rec, samples, interval, t_end,
+                   _rest_mask(rec.output.t_s, t_rest), reference=(t_ref, v_ref), controller=controller,
+                   rest_end_s=t_rest)
+    offset = run.baseline_offset(p) if offset else 0.0
+    return replace(run, reference_offset=offset, profile=reference_profile(t_ref, v_ref - offset, p))
 
 
 def reference_profile(t_s: np.ndarray, values_si: np.ndarray, p: ParameterSet) -> TargetProfile:

@@ -15,6 +15,10 @@ ordinary least-squares fit then has the *sandwich* covariance
 N x N matrix is formed). With rho_k = 0 and one common variance it is s^2 (J^T J)^-1, which
 is also returned (``white``). For white noise rho is near 0 and both agree; a systematic
 misfit shows as rho near 1 and widens C by up to sqrt((1 + rho) / (1 - rho)) in standard error.
+
+A quantity the data do not determine gets an infinite variance: one in a direction J^T J does
+not see (:func:`null_directions`), and, where the quantities have bounds, one whose standard
+error exceeds the width of its bounds (:func:`mark_undetermined`).
 """
 
 from __future__ import annotations
@@ -63,8 +67,9 @@ class Covariance:
     dof : int
         Residuals minus fitted quantities.
     rank_deficient : bool
-        J^T J was singular: some quantities are not identified. Their variances are infinite
-        (the other entries come from a pseudo-inverse).
+        Some quantities are not determined: J^T J was singular (the other entries then come from
+        a pseudo-inverse), or a standard error exceeded the width of the bounds
+        (:func:`mark_undetermined`). Their variances are infinite (:attr:`undetermined`).
     """
 
     ar1: np.ndarray
@@ -73,6 +78,11 @@ class Covariance:
     sigma: np.ndarray
     dof: int
     rank_deficient: bool
+
+    @property
+    def undetermined(self) -> np.ndarray:
+        """Which quantities are not determined (an infinite variance), bool each."""
+        return ~np.isfinite(np.diag(self.ar1))
 
     @property
     def stderr(self) -> np.ndarray:
@@ -131,3 +141,31 @@ def null_directions(A: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
     w, V = np.linalg.eigh(S)
     null = V[:, w <= rtol * max(float(w.max()), 0.0)] if w.size else V[:, :0]
     return zero | (np.abs(null) > 1e-6).any(axis=1)
+
+
+def mark_undetermined(cov: Covariance, widths: np.ndarray) -> Covariance:
+    """``cov`` with every quantity whose standard error exceeds the width of its allowed range
+    marked not determined, as a null direction is: its variances infinite (both), and
+    ``rank_deficient`` set.
+
+    :func:`null_directions` scales every column to unit size, so a quantity whose column is
+    tiny but not zero (a temperature band a run barely reaches) passes as identified, with a
+    finite standard error billions of times its range. Data that leave a quantity anywhere in
+    its bounds, and beyond, do not determine it.
+
+    Parameters
+    ----------
+    cov : Covariance
+        In the units of ``widths``.
+    widths : array_like
+        The width of each quantity's range (hi - lo; ``inf`` for an unbounded one, such as an
+        offset).
+    """
+    widths = np.asarray(widths, dtype=np.float64)
+    wide = ~(cov.stderr <= widths)  # an infinite variance stays marked
+    if not wide.any():
+        return cov
+    ar1, white = cov.ar1.copy(), cov.white.copy()
+    for c in (ar1, white):
+        c[wide, wide] = np.inf
+    return Covariance(ar1, white, cov.rho, cov.sigma, cov.dof, True)

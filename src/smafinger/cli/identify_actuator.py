@@ -26,8 +26,6 @@ from .choices import FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 from .common import repeated_file
 
 CMD = "smafinger identify actuator"
-#: warn when the fitted runs' RMS exceeds the baseline noise by this factor
-MISFIT_WARN = 1.5
 #: separates a run's file from its own mapping: RUN.mat::duty=u,position_m=x_mm*1e-3
 RUN_MAP = "::"
 
@@ -127,6 +125,9 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     runs += [load_open_loop(*_run_map(a, maps), "validate", p, wire=wire) for a in validate]
     runs += [load_closed_loop(*_run_map(a, maps), p, controller, reference=reference, offset=offset == "per-run")
              for a in replay]
+    for run in runs if offset == "per-run" else []:
+        if run.role == "validate":  # its offset is measured on its baseline (a fitted run's is fitted)
+            run.check_baseline()
     box = FreeBox(p, parse_free(p, free)) if fit else None
     settings = FitSettings(budget=budget, max_nfev=max_nfev, seed=seed, fit_offsets=offset == "per-run")
     base = params if (params in REGISTRY and not overrides) else p
@@ -204,6 +205,8 @@ def _compute(setup: dict, show: bool) -> dict:
         p = fit.params if fit else setup["p"]
         offsets = {f: (fit.offsets[f], fit.offset_stderr[f]) for f in fit.offsets} if fit else {}
         predictions = ar.predict_runs(runs, p, pool, offsets, setup["offset"], s.dt_s)
+    if fit is not None:  # whether the fit reaches the noise: warned and in the report's notes
+        fit.notes.extend(ar.misfit_notes(predictions, p))
     return {"fit": fit, "p": p, "predictions": predictions}
 
 
@@ -305,10 +308,6 @@ def _print(setup: dict, result: dict) -> None:
     for pr in preds:
         if pr.error:
             typer.echo(f"warning: {pr.run.file}: simulation failed: {pr.error}", err=True)
-    ratio = ar.role_summary(preds, p).get("fit", {}).get("rms_over_noise")
-    if ratio is not None and ratio > MISFIT_WARN:
-        typer.echo(f"warning: the fitted runs' RMS is {ratio:.2g} times the sensor noise measured before the "
-                   f"drive: a local minimum (try a larger --budget or another --seed) or a model error", err=True)
 
 
 def _jsonable(x):
