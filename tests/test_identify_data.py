@@ -241,3 +241,22 @@ def test_voltage_programs_from_columns_and_heat_s(tmp_path):
     assert heating_program(h, 6.0).steps == ((0.0, 6.0, 0.0),)
     with pytest.raises(ValueError, match="heat_s"):
         cooling_program(h, 5.0, math.nan)
+
+
+def test_an_angle_curve_must_count_its_time_from_the_switch_on(tmp_path):
+    """t = 0 is the switch-on: a curve logged from t = 100 s was read as a 103.5 s heating program
+    and fitted to nonsense (heating RMS 11.9 deg for 0.05, exit 0; found by review). Its first row
+    may be after 0 by at most its first sampling interval."""
+    rows = angle_rows()  # every 0.1 s from 0
+    shifted = [rows[0]] + [f"{100 + 0.1 * i:.2f}," + r.split(",", 1)[1] for i, r in enumerate(rows[1:])]
+    msg = error_of(load_angle_curve, write(tmp_path / "late.csv", shifted))
+    assert "row 1 (line 2): time 100 s of the first row is after 0 by more than the first sampling " \
+           "interval (0.1 s)" in msg and "switched on" in msg
+    # a curve whose first sample is one interval after the switch-on is fine, a little more is not
+    for first, ok in ((0.1, True), (0.05, True), (0.1001, False)):
+        late = [rows[0]] + [f"{first + 0.1 * i:.4f}," + r.split(",", 1)[1] for i, r in enumerate(rows[1:])]
+        path = write(tmp_path / f"first{first}.csv", late)
+        if ok:
+            assert load_angle_curve(path).t_s[0] == pytest.approx(first)
+        else:
+            assert "of the first row is after 0" in error_of(load_angle_curve, path)

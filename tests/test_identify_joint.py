@@ -1,5 +1,6 @@
 """Joint-level fit (Fig. 9): recovery of h0, h2, C_DF from synthetic curves, nonsmoothness."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -142,3 +143,19 @@ def test_a_coefficient_stopped_at_its_search_bound_is_warned_of():
     assert _bound_warnings("cooling", obj, np.array([0.0, -6.9]), {"h0_cooling_W_m2K": 41.0,
                                                                     "C_DF_cooling_Nms": 1e-4})[0].startswith(
         "cooling: C_DF_cooling_Nms = 0.0001 is at the lower bound")
+
+
+def test_a_curve_logged_from_a_later_time_is_refused_not_fitted(tmp_path):
+    """A heating curve logged from t = 100 s was read as a 103.5 s program: heating RMS 11.86 deg,
+    h0_cooling 7e-13, exit 0 (found by review). Now exit 2, one line naming the file, the row and
+    the time, and nothing written."""
+    curve = synthesize(TRUTH, "0:5:0", 5.0, SAMPLE_S, NOISE_DEG, seed=11)
+    late = write_csv(tmp_path / "heat_t100.csv", dataclasses.replace(curve, t_s=curve.t_s + 100.0))
+    cool = write_csv(tmp_path / "cool.csv", synthesize(TRUTH, "0:8:0,1:0:0", 3.0, SAMPLE_S, NOISE_DEG, seed=12))
+    out = tmp_path / "fit.toml"
+    r = CliRunner().invoke(app, ["joint", "--heating", str(late), "--cooling", str(cool), "--out", str(out),
+                                 "--no-progress"])
+    assert r.exit_code == 2, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert f"{late}: row 1 (line 2): time 100 s of the first row is after 0" in r.stderr
+    assert not out.exists()

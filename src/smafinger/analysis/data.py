@@ -15,7 +15,11 @@ Two kinds of file:
   as degrees or seconds. Any other column, a second column for the same quantity and a value
   in a column the header does not name are refused too (a voltage column under another name
   was dropped, and the curve fitted at the default voltage); a column without a name (a
-  trailing comma) may stay if it holds no values.
+  trailing comma) may stay if it holds no values. Time counts from the switch-on of the wire
+  (t = 0): the first row must be at most one sampling interval (its own, to the second row)
+  after 0 (:data:`FIRST_TIME_SLACK`), else the curve is refused rather than fitted as a drive
+  that started when the logger did (a curve logged from t = 100 s was read as a 103.5 s heating
+  program and fitted to nonsense). Subtract the switch-on time from such a log.
 
 Any problem raises :class:`DataError` with one line naming the file, the row and the problem.
 "Row N" counts data rows from 1; the file's line number is given too.
@@ -42,6 +46,9 @@ STRAIN_RANGE = (-0.05, 0.2)
 ANGLE_RANGE_DEG = (-180.0, 180.0)
 VOLTAGE_RANGE_V = (0.0, 100.0)
 MAX_TIME_S = 600.0
+#: an angle curve's first time may be after 0 (the switch-on) by at most its first sampling
+#: interval times this (the slack covers the rounding of logged times)
+FIRST_TIME_SLACK = 1.0 + 1e-6
 
 #: smallest strain span of a strain-temperature curve (0.1 % strain: a transformation shows
 #: as several percent; the sma-thermal-cycling curves span 4.1-4.6 %)
@@ -117,7 +124,7 @@ class StrainCurve:
 
     path: str
     T_C: np.ndarray
-    strain: np.ndarray  #: from the curve's minimum (the austenite state): the file's values shifted
+    strain: np.ndarray  #: the file's values shifted to a minimum of 0 (the sensor's zero; the fit adds an offset)
     stress_Pa: np.ndarray
     split: int  # row index of the maximum temperature (last row of the heating half)
 
@@ -183,9 +190,9 @@ def load_strain_curve(path: str | Path) -> StrainCurve:
             f"leaves too few points for the {half} half (rows must heat first, then cool; at "
             f"least {MIN_ROWS_HALF} rows each)")
     _check_transformation(path, T, e, split)
-    # the strain measured from the curve's austenite state, its minimum (kinetics_fit: "Offset");
-    # the fit has no free offset, so a file measured from another reference (the unloaded length)
-    # would move every fitted temperature
+    # the strain from the curve's minimum: its zero is the sensor's, arbitrary. The shift is for
+    # reading only (every curve from 0); the fit takes each curve's austenite level as a fitted
+    # offset (kinetics_fit: "Offset"), since with noise the minimum lies below that level
     return StrainCurve(str(path), T, e - float(np.min(e)), s * 1e6, split)
 
 
@@ -333,7 +340,28 @@ def load_angle_curve(path: str | Path) -> AngleCurve:
     if n < MIN_ROWS_JOINT:
         where = _where(path, n, data[-1][0]) if n else _where(path, line=head_ln)
         raise DataError(f"{where}: too few points: {n} data rows, at least {MIN_ROWS_JOINT} are needed")
+    _check_first_time(path, t, data[0][0])
     return AngleCurve(str(path), t, a, v)
+
+
+def _check_first_time(path, t: np.ndarray, line: int) -> None:
+    """Refuse a curve whose time does not count from the switch-on: its first row more than one
+    sampling interval (the first one, ``t[1] - t[0]``) after 0 (see the module docstring).
+
+    Parameters
+    ----------
+    path : path
+        The file, for the message.
+    t : ndarray
+        The curve's times [s], increasing, at least two.
+    line : int
+        The file's line number of the first data row.
+    """
+    dt = float(t[1] - t[0])
+    if t[0] > FIRST_TIME_SLACK * dt:
+        raise DataError(f"{_where(path, 1, line)}: time {t[0]:g} s of the first row is after 0 by more than the "
+                        f"first sampling interval ({dt:g} s): t = 0 is when the wire is switched on, so give "
+                        f"the time from then (subtract the switch-on time)")
 
 
 # ---------------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ import math
 from typing import TYPE_CHECKING, Sequence
 
 from .data import StrainCurve
-from .kinetics_model import model_curve, rms_strain
+from .kinetics_model import model_curve, offset_residual, rms_strain
 
 if TYPE_CHECKING:
     from .kinetics_fit import KineticsFit
@@ -17,6 +17,7 @@ def kinetics_figure(fit: KineticsFit, fitted: Sequence[StrainCurve], validated: 
     """Data vs model (strain in % against temperature), one panel per curve.
 
     Solid: the fit on all fitted curves; dashed: the leave-one-out prediction of that curve.
+    Each model line is drawn with the curve's fitted offset (:func:`.kinetics_model.offset_residual`).
     """
     from matplotlib.figure import Figure
 
@@ -34,12 +35,14 @@ def kinetics_figure(fit: KineticsFit, fitted: Sequence[StrainCurve], validated: 
         ax.plot(c.T_C[h], 100 * c.strain[h], ".", ms=2.5, color="tab:red", alpha=0.6, label="data, heating")
         ax.plot(c.T_C[k], 100 * c.strain[k], ".", ms=2.5, color="tab:blue", alpha=0.6, label="data, cooling")
         _, m = model_curve(fit.params, c, fit.stress)
+        m = m + offset_residual(m, c.strain)[1]
         rms = rms_strain(fit.params, c, fit.stress)
         ax.plot(c.T_C[h], 100 * m[h], "-", color="darkred", lw=1.4, label="model (all fitted)")
         ax.plot(c.T_C[k], 100 * m[k], "-", color="navy", lw=1.4)
         title = f"{c.name}: {c.stress_MPa_mean:.0f} MPa, {role}, RMS {100 * rms:.3f}%"
         if c.path in loo_by:
             _, ml = model_curve(loo_by[c.path]["params"], c, fit.stress)
+            ml = ml + offset_residual(ml, c.strain)[1]
             ax.plot(c.T_C, 100 * ml, "--", color="k", lw=0.9, label="leave-one-out prediction")
             title += f"\nleft out: RMS {100 * loo_by[c.path]['rms_strain']:.3f}%"
         ax.set_title(title, fontsize=9)

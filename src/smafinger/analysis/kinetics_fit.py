@@ -2,7 +2,7 @@
 
 Model of a measured curve (row ``i`` at temperature ``T_i`` and stress ``sigma_i``)::
 
-    strain_i = eps_R xi_i + sigma_i (1/D(xi_i) - 1/D_A),   D(xi) = D_A + xi (D_M - D_A)
+    strain_i = eps_R xi_i + sigma_i (1/D(xi_i) - 1/D_A) + offset,   D(xi) = D_A + xi (D_M - D_A)
 
 ``xi`` comes from the package's own kinetics (:func:`smafinger.model.kinetics.martensite_fraction`
 and :func:`~smafinger.model.kinetics.branch_start`): the heating branch (Eq. 9) on the heating
@@ -11,11 +11,18 @@ the simulator's minor-loop rule (the cooling branch's start value xi_A0 is re-so
 reversal so that xi is continuous). The first row starts fully martensitic (xi = 1), as after
 cooling under load.
 
-Offset: the data is shifted so that its minimum (the austenite state) is 0, so the model's strain
-is measured from the austenite state at the same stress: the elastic part is
-``sigma/D(xi) - sigma/D_A``, which is 0 when xi = 0. No free offset is fitted. The absolute
-elastic strain is therefore not observable; only ``1/D_M - 1/D_A`` is, so D_A is held at the
-base set's value and D_M is fitted (``fit_moduli``).
+Offset: the zero of a measured strain curve is arbitrary (the sensor's zero; the loader shifts
+each curve to a minimum of 0, and with noise that minimum lies a few noise levels below the
+austenite level). The model's strain is measured from the austenite state at the same stress
+(the elastic part ``sigma/D(xi) - sigma/D_A`` is 0 when xi = 0), and each curve gets one fitted
+strain offset, the austenite level in the curve's zero. It is profiled out
+(:func:`.kinetics_model.offset_residual`: for given kinetics the best offset is the curve's mean
+of measured minus model), so the optimiser sees only the kinetics; the residuals' Jacobian is
+that of the projected residuals, so the standard errors allow for the offsets, and they count
+in ``N - p``. A curve only predicted (``--validate``, leave-one-out) gets its offset fitted the
+same way, the one thing fitted to it. The absolute elastic strain is not observable (the
+offsets absorb it); only ``1/D_M - 1/D_A`` is, so D_A is held at the base set's value and D_M is
+fitted (``fit_moduli``).
 
 Stress: by default each curve uses its mean measured stress (the load is a dead weight; the
 row-to-row scatter of the measured stress, about +-5 MPa, is load-cell noise and would move the
@@ -23,9 +30,10 @@ transformation temperatures by about +-0.7 degC per row). ``stress="row"`` uses 
 
 All curves are fitted together (so that the stress slopes c_A and c_M are identified) with
 :func:`scipy.optimize.least_squares`; standard errors come from its Jacobian,
-``cov = s^2 (J^T J)^-1`` with ``s^2 = SSR / (N - p)``. Neighbouring residuals of a filtered
-curve are strongly correlated, which this formula ignores; ``stderr_ar1`` inflates it by
-``sqrt((1 + r1) / (1 - r1))`` (r1: lag-1 autocorrelation of the residuals), a more honest size.
+``cov = s^2 (J^T J)^-1`` with ``s^2 = SSR / (N - p)`` (p: the free kinetics entries and one
+offset per curve). Neighbouring residuals of a filtered curve are strongly correlated, which
+this formula ignores; ``stderr_ar1`` inflates it by ``sqrt((1 + r1) / (1 - r1))`` (r1: lag-1
+autocorrelation of the residuals), a more honest size.
 
 The pieces: :mod:`.kinetics_model` (the model strain and the fit vector), :mod:`.kinetics_guess`
 (the starting values), :mod:`.kinetics_figure` (the figure); this module holds the fit. Their
@@ -49,8 +57,8 @@ from .data import StrainCurve
 from .kinetics_figure import kinetics_figure  # noqa: F401
 from .kinetics_guess import initial_guess
 from .kinetics_model import (  # noqa: F401
-    KINETIC_FIELDS, X_HI, X_LO, X_NAMES, X_SCALE, X_TO_FIELDS, KineticParams, curve_stress, model_curve,
-    rms_strain, strain_path,
+    KINETIC_FIELDS, X_HI, X_LO, X_NAMES, X_SCALE, X_TO_FIELDS, KineticParams, curve_offset, curve_stress,
+    model_curve, offset_residual, rms_strain, strain_path,
 )
 
 MIN_STRESS_SPAN_MPA = 5.0  # below this spread of the curves' mean stresses, c_A and c_M are held
@@ -75,6 +83,9 @@ class KineticsFit:
     correlation: dict[str, dict[str, float]] = field(default_factory=dict)
     at_bounds: list[str] = field(default_factory=list)  # fit-vector entries stuck at a bound
     notes: list[str] = field(default_factory=list)
+    #: per fitted curve path: its strain offset, the austenite level in the curve's zero (the
+    #: loader's: above the curve's minimum)
+    offsets: dict[str, float] = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         return {
@@ -92,6 +103,7 @@ class KineticsFit:
             "correlation": self.correlation,
             "at_bounds": self.at_bounds,
             "notes": self.notes,
+            "offsets": self.offsets,
         }
 
 
@@ -112,7 +124,7 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
     """Fit all curves together. ``base`` supplies the start of D_A/D_M and any held values.
 
     ``fit_moduli``: which of ``"D_M"``, ``"D_A"`` are free (only ``1/D_M - 1/D_A`` is observable
-    from min-shifted data, so freeing both is ill-posed; see the module docstring).
+    with a fitted offset per curve, so freeing both is ill-posed; see the module docstring).
     ``on_eval(n)`` is called after every model evaluation (for progress display).
     """
     if not curves:
@@ -126,7 +138,7 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
                         ftol=1e-12, gtol=1e-10)
     kp = KineticParams._from_x(_full_x(x_all, free, res.x))
     r = res.fun
-    cov = _field_covariance(r, res.jac, free)
+    cov = _field_covariance(r, res.jac, free, len(curves))
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     fitted = _fitted_fields(free)
     stderr = {f: float(se[i]) for i, f in enumerate(KINETIC_FIELDS) if f in fitted}
@@ -135,7 +147,8 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
                        fitted=fitted, rms={c.path: rms_strain(kp, c, stress) for c in curves},
                        rms_all=float(np.sqrt(np.mean(r * r))), n_points=r.size, nfev=int(res.nfev),
                        success=bool(res.success), message=str(res.message), stress=stress, initial=init,
-                       correlation=_correlation(cov, fitted), at_bounds=_at_bounds(res.x, free), notes=notes)
+                       correlation=_correlation(cov, fitted), at_bounds=_at_bounds(res.x, free), notes=notes,
+                       offsets={c.path: curve_offset(kp, c, stress) for c in curves})
 
 
 def _fit_start(curves: Sequence[StrainCurve], base_kp: KineticParams,
@@ -185,7 +198,8 @@ def _full_x(x_all: np.ndarray, free: np.ndarray, xf: np.ndarray) -> np.ndarray:
 
 def _residual_function(curves: Sequence[StrainCurve], x_all: np.ndarray, free: np.ndarray, stress: str,
                        on_eval: Callable[[int], None] | None) -> Callable[[np.ndarray], np.ndarray]:
-    """The residuals (model - measured strain, all curves concatenated) of the free entries.
+    """The residuals (model + offset - measured strain, all curves concatenated, each curve's
+    offset profiled out by :func:`.kinetics_model.offset_residual`) of the free entries.
 
     Parameters
     ----------
@@ -216,7 +230,7 @@ def _residual_function(curves: Sequence[StrainCurve], x_all: np.ndarray, free: n
         for c, Tc, sig, (xi, eps) in zip(curves, T, stresses, bufs):
             strain_path(Tc, sig, int(c.split), kp.A_S0_C, kp.A_F0_C, kp.c_A_Pa_per_C, kp.M_S0_C,
                         kp.M_F0_C, kp.c_M_Pa_per_C, kp.eps_R, kp.D_A_Pa, kp.D_M_Pa, xi, eps)
-            out.append(eps - c.strain)
+            out.append(offset_residual(eps, c.strain)[0])
         count[0] += 1
         if on_eval is not None:
             on_eval(count[0])
@@ -225,11 +239,14 @@ def _residual_function(curves: Sequence[StrainCurve], x_all: np.ndarray, free: n
     return residuals
 
 
-def _field_covariance(r: np.ndarray, J: np.ndarray, free: np.ndarray) -> np.ndarray:
+def _field_covariance(r: np.ndarray, J: np.ndarray, free: np.ndarray, n_offsets: int) -> np.ndarray:
     """Covariance of the fields (:data:`KINETIC_FIELDS`, in field units) by the delta method.
 
     ``cov = s^2 (J^T J)^-1`` of the free entries of the fit vector, ``s^2 = SSR / (N - p)``,
-    mapped to the fields by :data:`.kinetics_model.X_TO_FIELDS` (held entries: 0).
+    mapped to the fields by :data:`.kinetics_model.X_TO_FIELDS` (held entries: 0). ``J`` is the
+    Jacobian of the residuals with the offsets profiled out, ``(I - P) J_full``; its
+    ``(J^T J)^-1`` is the kinetics block of the full problem's (offsets as unknowns), so the
+    offsets' uncertainty is included. p counts the free entries and the offsets.
 
     Parameters
     ----------
@@ -239,13 +256,15 @@ def _field_covariance(r: np.ndarray, J: np.ndarray, free: np.ndarray) -> np.ndar
         Their Jacobian in the free entries.
     free : ndarray of bool
         Which entries of the fit vector are free.
+    n_offsets : int
+        The number of profiled-out offsets (one per curve).
 
     Returns
     -------
     ndarray
         Covariance matrix, one row and column per field.
     """
-    n, p = r.size, int(free.sum())
+    n, p = r.size, int(free.sum()) + n_offsets
     s2 = float(r @ r) / max(n - p, 1)
     cov_f = s2 * np.linalg.pinv(J.T @ J)
     cov_x = np.zeros((len(X_NAMES), len(X_NAMES)))
@@ -311,7 +330,9 @@ def leave_one_out(curves: Sequence[StrainCurve], base: ParameterSet | KineticPar
                   fit_moduli: Sequence[str] = ("D_M",), stress: str = "mean",
                   on_fit: Callable[[int, str], None] | None = None) -> list[dict]:
     """Fit on all curves but one, predict the one left out; one entry per curve (``path``,
-    ``stress_MPa``, ``rms_strain`` of the prediction, fitted ``values`` and ``params``).
+    ``stress_MPa``, ``rms_strain`` of the prediction with the left-out curve's own strain offset
+    fitted (:func:`.kinetics_model.rms_strain`: its zero is the sensor's), fitted ``values`` and
+    ``params``).
 
     Needs at least three curves (two remain to identify the stress slopes); else ``[]``.
     ``on_fit(i, name)`` is called after each fit.

@@ -26,7 +26,8 @@ def _crossing(T: np.ndarray, y: np.ndarray, level: float) -> float:
 
 def initial_guess(curves: Sequence[StrainCurve], base: KineticParams) -> KineticParams:
     """Transformation temperatures from where each half crosses 90% / 10% of its strain span,
-    the stress slopes from a straight line through them across the curves."""
+    the stress slopes from a straight line through them across the curves; eps_R from the
+    curves' strain spans (independent of each curve's zero, which the fit's offsets take)."""
     # for 0.5 (cos(pi u) + 1): xi = 0.9 at u = 0.205, 0.1 at u = 0.795
     u90, u10 = math.acos(0.8) / math.pi, math.acos(-0.8) / math.pi
     rows = []
@@ -43,7 +44,7 @@ def initial_guess(curves: Sequence[StrainCurve], base: KineticParams) -> Kinetic
         c90, c10 = _crossing(Tc, yc, 0.9), _crossing(Tc, yc, 0.1)
         wM = max((c10 - c90) / (u10 - u90), 1.0)
         M_F = c90 - u90 * wM
-        rows.append((c.stress_MPa_mean, A_S, wA, M_F, wM, hi))
+        rows.append((c.stress_MPa_mean, A_S, wA, M_F, wM, hi - lo))
     a = np.array(rows)
     s = a[:, 0]
     c_A, c_M = base.c_A_Pa_per_C / 1e6, base.c_M_Pa_per_C / 1e6

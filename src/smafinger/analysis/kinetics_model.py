@@ -3,7 +3,10 @@
 ``strain_i = eps_R xi_i + sigma_i (1/D(xi_i) - 1/D_A)``, ``D(xi) = D_A + xi (D_M - D_A)``, with
 ``xi`` from the package's own kinetics (heating branch, Eq. 9, up to the maximum temperature,
 then the cooling branch, Eq. 10, with the simulator's minor-loop rule); see :mod:`.kinetics_fit`.
-Also the fit vector (the kinetics parameters in the units and differences the fit works in).
+That strain is measured from the austenite state at the curve's stress; the measured curve adds
+its own offset (the sensor's zero), profiled out by :func:`offset_residual` (the one place that
+rule lives). Also the fit vector (the kinetics parameters in the units and differences the fit
+works in).
 """
 
 from __future__ import annotations
@@ -108,7 +111,40 @@ def model_curve(kp: KineticParams, curve: StrainCurve, stress: str = "mean") -> 
     return xi, eps
 
 
+def offset_residual(model: np.ndarray, measured: np.ndarray) -> tuple[np.ndarray, float]:
+    """Residual of one curve with its strain offset profiled out.
+
+    The zero of a measured strain curve is arbitrary (the sensor's zero, and the loader's shift
+    to the curve's minimum, which noise pulls below the austenite level): the curve is modelled
+    as ``model + offset``, one constant per curve. For given kinetics the least-squares offset
+    is the mean of ``measured - model`` (variable projection), so the fit never sees it as an
+    unknown, yet its standard errors include it (the Jacobian of the projected residual).
+
+    Parameters
+    ----------
+    model : ndarray
+        The model strain along the curve (:func:`model_curve`, from the austenite state).
+    measured : ndarray
+        The curve's measured strain.
+
+    Returns
+    -------
+    residual : ndarray
+        ``model + offset - measured``.
+    offset : float
+        The fitted offset: the measured strain of the austenite state, in the curve's zero.
+    """
+    offset = float(np.mean(measured - model))
+    return model + offset - measured, offset
+
+
+def curve_offset(kp: KineticParams, curve: StrainCurve, stress: str = "mean") -> float:
+    """The strain offset of a curve under ``kp`` (:func:`offset_residual`)."""
+    return offset_residual(model_curve(kp, curve, stress)[1], curve.strain)[1]
+
+
 def rms_strain(kp: KineticParams, curve: StrainCurve, stress: str = "mean") -> float:
-    """RMS of (model - measured) strain over a curve."""
-    r = model_curve(kp, curve, stress)[1] - curve.strain
+    """RMS of (model + offset - measured) strain over a curve, its offset fitted
+    (:func:`offset_residual`): for a curve not in the fit, the one thing fitted to it."""
+    r = offset_residual(model_curve(kp, curve, stress)[1], curve.strain)[0]
     return float(np.sqrt(np.mean(r * r)))
