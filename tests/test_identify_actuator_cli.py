@@ -220,3 +220,24 @@ def test_a_parameter_the_runs_barely_see_is_not_determined(tmp_path):
     assert 0 < fit["stderr"]["A_S0_C"] < 0.1  # the heating pins the austenite start
     assert "warning: not determined by these runs: M_S0_C, M_F0_C (" in r.output
     assert any(n.startswith("not determined by these runs: M_S0_C, M_F0_C") for n in fit["notes"])
+
+
+def test_a_baseline_without_noise_is_not_called_missing(tmp_path):
+    """A sensor that reads one count at rest measures a noise of 0: the note said that no run had
+    samples at rest before its drive, while each had 50 (found by review)."""
+    truth = LINEAR.replace(A_S0_C=72.0)
+    truth.save(tmp_path / "truth.toml")
+    bs.write_csv(tmp_path / "q.csv", bs.open_loop_run(truth, "0:0,0.5:0.3,2:0", 3.0, noise=0.0, seed=4))
+    import pandas as pd
+
+    df = pd.read_csv(tmp_path / "q.csv", dtype=str)
+    at_rest = df.t_s.astype(float) <= 0.5 + 1e-9  # the baseline: up to the switch-on, inclusive
+    df.loc[at_rest, "position_m"] = df.position_m.iloc[0]  # one count at rest
+    df.to_csv(tmp_path / "q.csv", index=False)
+    r = invoke("--params", tmp_path / "truth.toml", "--fit", tmp_path / "q.csv", "--free", "eps_R", "--budget", "0",
+               "--max-nfev", "3", "--workers", "1", "--report", tmp_path / "r.json")
+    assert r.exit_code == 0, r.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["files"][0]["baseline_samples"] >= 5 and rep["files"][0]["noise_m"] == 0.0
+    assert "the samples at rest before the drive show none (a quantized sensor" in r.output
+    assert "no fitted run has" not in r.output

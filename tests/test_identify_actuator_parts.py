@@ -314,3 +314,11 @@ def test_a_standard_error_wider_than_the_bounds_is_not_determined():
     assert math.isinf(marked.stderr[1]) and math.isinf(marked.stderr_white[1])
     np.testing.assert_array_equal(marked.stderr[[0, 2]], cov.stderr[[0, 2]])
     assert mark_undetermined(cov, [np.inf, 1e12, 30.0]) is cov  # within its range: determined
+    # bounds a user drew narrower than a determined quantity's standard error: the bounds fix it,
+    # not "not determined" (found by review); only UNDETERMINED_WIDTHS times its range counts
+    from smafinger.analysis.fit_uncertainty import UNDETERMINED_WIDTHS
+
+    se = cov.stderr[2]
+    assert mark_undetermined(cov, [np.inf, 1e12, se / (UNDETERMINED_WIDTHS * 0.99)]) is cov
+    assert mark_undetermined(cov, [np.inf, 1e12, se / (UNDETERMINED_WIDTHS * 1.01)]).undetermined.tolist() == [
+        False, False, True]

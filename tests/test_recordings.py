@@ -177,6 +177,11 @@ def test_mat_structure_with_time_of_1d_arrays(tmp_path, oned_as):
 def test_a_refusal_lists_a_dozen_names_at_most(tmp_path):
     from smafinger.recordings.reader import LISTED_NAMES
 
+    wide = tmp_path / "wide.csv"  # no time column among 300: the CSV reader's own refusal
+    wide.write_text(",".join(f"c{k}" for k in range(300)) + "\n" + ",".join("1" for _ in range(300)) + "\n")
+    msg = refusal(wide)
+    assert "no time column" in msg and "and 288 more" in msg and len(msg) < 1000
+
     t = np.linspace(0.0, 1.0, 11)
     f = tmp_path / "many.mat"
     sio.savemat(f, {"tout": t[:, None], **{f"sig{k:03d}": t[:, None] for k in range(200)}})

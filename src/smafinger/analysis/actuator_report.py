@@ -189,9 +189,13 @@ def misfit_notes(predictions: Sequence[RunPrediction], p: ParameterSet) -> list[
     if ratio is not None:
         return [f"the fitted runs' RMS is {ratio:.2g} times the sensor noise measured before the drive: "
                 f"{advice}"] if ratio > MISFIT_WARN else []
-    notes = [f"the fitted runs' RMS ({factor * fit[f'rms_{unit_suffix(p)}']:.4g} {unit}) could not be judged "
-             f"against the sensor noise: no fitted run has {MIN_NOISE_SAMPLES} or more samples at rest before its "
-             "drive turns on, which measure it (record half a second before switching the drive on)"]
+    rms = f"the fitted runs' RMS ({factor * fit[f'rms_{unit_suffix(p)}']:.4g} {unit}) could not be judged against the "
+    if fit[f"noise_{unit_suffix(p)}"] is None:
+        notes = [rms + f"sensor noise: no fitted run has {MIN_NOISE_SAMPLES} or more samples at rest before its drive "
+                 "turns on, which measure it (record half a second before switching the drive on)"]
+    else:  # measured, and 0: a quantized sensor reading one count at rest (found by review)
+        notes = [rms + "sensor noise: the samples at rest before the drive show none (a quantized sensor, reading "
+                 "one count)"]
     rho = [(Path(pr.run.file).name, pr.stats()["lag1"]) for pr in predictions
            if (pr.run.role, pr.run.mode) == SUMMARY_GROUPS["fit"]]
     slow = [f"{r:.3g} on {name}" for name, r in rho if r > RHO_MISFIT]

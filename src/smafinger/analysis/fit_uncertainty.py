@@ -143,9 +143,15 @@ def null_directions(A: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
     return zero | (np.abs(null) > 1e-6).any(axis=1)
 
 
+#: a standard error this many times the width of its quantity's range: not determined by the
+#: data (:func:`mark_undetermined`; not 1: a user's bounds narrower than a well-determined
+#: quantity's standard error said "not determined", found by review)
+UNDETERMINED_WIDTHS = 10.0
+
+
 def mark_undetermined(cov: Covariance, widths: np.ndarray) -> Covariance:
-    """``cov`` with every quantity whose standard error exceeds the width of its allowed range
-    marked not determined, as a null direction is: its variances infinite (both), and
+    """``cov`` with every quantity whose standard error exceeds :data:`UNDETERMINED_WIDTHS`
+    times the width of its allowed range marked not determined, as a null direction is: its variances infinite (both), and
     ``rank_deficient`` set.
 
     :func:`null_directions` scales every column to unit size, so a quantity whose column is
@@ -162,7 +168,7 @@ def mark_undetermined(cov: Covariance, widths: np.ndarray) -> Covariance:
         offset).
     """
     widths = np.asarray(widths, dtype=np.float64)
-    wide = ~(cov.stderr <= widths)  # an infinite variance stays marked
+    wide = ~(cov.stderr <= UNDETERMINED_WIDTHS * widths)  # an infinite variance stays marked
     if not wide.any():
         return cov
     ar1, white = cov.ar1.copy(), cov.white.copy()

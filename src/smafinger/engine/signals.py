@@ -84,9 +84,9 @@ WC = WireColumns(*range(len(WIRE_FIELDS)))
 
 #: what a run's metrics and plausibility checks read (``results.compute_metrics``): all a sweep's
 #: table needs. A run made with ``record="metrics"`` records these signals alone (the kernel
-#: writes 12 of the joint's 35 values a sample); a test checks that its metrics are the same.
-#: (the casing temperature for the plausibility check's casing warning: a sweep's rows give the same
-#: warnings as simulate, found by review)
+#: writes 14 of the joint's 35 values a sample); a test checks that its metrics are the same.
+#: The casing temperature is among them for the plausibility check's casing warning, so that a
+#: sweep's rows give the warnings simulate gives (found by review).
 METRIC_FIELDS = ("t", "q", "T", "xi", "sigma", "electrical", "heat", "T_case")
 #: what a run records: every signal, or the :data:`METRIC_FIELDS`
 RECORD = ("all", "metrics")

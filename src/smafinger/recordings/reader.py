@@ -77,7 +77,7 @@ def _open(path: Path, fmt: str, smap: SignalMap):
 LISTED_NAMES = 12
 
 
-def _listing(names) -> str:
+def name_listing(names) -> str:
     """The names, quoted, at most :data:`LISTED_NAMES` of them (then how many more)."""
     names = list(names)
     shown = ", ".join(map(repr, names[:LISTED_NAMES])) or "none"
@@ -88,7 +88,7 @@ def _choose(source_file, smap: SignalMap) -> dict[str, str]:
     """canonical signal name -> role (``input``, ``output``, ``T_C``, ``resistance_ohm``)."""
     names = set(source_file.names)
     what, path = source_file.what, source_file.path
-    listing = _listing(source_file.names)
+    listing = name_listing(source_file.names)
     for name, src in smap.entries:
         if name != TIME and src.name not in names:
             raise RecordingError(f"{path}: mapping {name}={src.to_text()}: no {what} {src.name!r} "

@@ -11,6 +11,7 @@ from collections import Counter
 import numpy as np
 
 from .mapping import SignalMap, Source
+from .reader import name_listing
 from .signals import TIME, RawSignal, RecordingError, check_times, describe_row
 
 
@@ -46,7 +47,7 @@ class TabularFile:
         self.time = smap.source(TIME)
         if self.time.name not in self.names:
             raise RecordingError(
-                f"{self.path}: no time column {self.time.name!r} (columns: {', '.join(map(repr, self.names))}); "
+                f"{self.path}: no time column {self.time.name!r} (columns: {name_listing(self.names)}); "
                 f"name it t_s (seconds) or map it, e.g. --map t_s=time_ms*1e-3")
         self._t = None
 
