@@ -58,7 +58,7 @@ def _within_budget(got, ref, min_travel_deg: float) -> None:
     (dict(params="paper2010", strategy="cooperative", profile="0:-30", controller="fuzzy-pid"), REF),
     (dict(params="paper2010", strategy="cooperative", profile="0:-30", controller="resistance"), REF),
     (dict(params="linear-bias-spring", strategy="cooperative", profile="0:0.01"), REF),
-    (dict(params="linear-bias-spring", strategy="open-loop", **LINEAR_PROGRAM), STIFF),
+    (dict(params="linear-bias-spring", strategy="open-loop", **LINEAR_PROGRAM), REF),
     (dict(params="linear-bias-spring", strategy="open-loop", voltage="0:0.6,0.2:0", drive="duty"), REF),
     (dict(params="authors2020", strategy="open-loop", voltage="0:8:0"), EDGE),
     (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="open-loop", voltage="0:8:0"), LONG),
@@ -97,7 +97,7 @@ def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes,
     spec = make_spec(p, "open-loop", voltage=program, drive="duty", t_end_s=8.0)
     why = _fast_transformation(p, spec.voltage)
     assert (why is not None) == refused == (steps < MIN_BAND_STEPS)
-    assert _numerics(spec) == (REF if refused else STIFF)
+    assert _numerics(spec) == REF  # the rig's long step is refused anyway (its return to martensite)
     if refused:
         ms = float(why.split(" in ")[1].split(" ms")[0])
         assert ms == pytest.approx(5.0 * steps, rel=0.01) and f"fewer than {MIN_BAND_STEPS} long steps" in why
@@ -156,17 +156,24 @@ def test_the_sliding_mode_controllers_default_is_within_the_budget():
     np.testing.assert_allclose(fast.segment_reached_s, ref.segment_reached_s, atol=0.01)
 
 
-def test_the_linear_rigs_default_open_loop_run_is_within_its_budget():
+def test_the_linear_rigs_long_step_misses_the_return_so_it_is_no_default():
     """The algebraic stress law's long step (semi-implicit, the wire's stiffness implicit) on the
-    linear rig's 18 mm stroke, against RK4 at 0.1 ms (the same within 1e-7 mm as at 20 us):
-    measured 0.037 mm RMS, 0.51 mm max. Without the stiffness implicit, 5 ms steps ran into
-    the end stop (10 mm RMS), and exponential Euler did at any step (1.5 mm RMS at 0.1 ms)."""
-    fast = simulate("linear-bias-spring", "open-loop", **LINEAR_PROGRAM)
-    ref = simulate("linear-bias-spring", "open-loop", **LINEAR_PROGRAM, dt_s=1e-4)
-    assert _numerics(fast.spec) == STIFF
-    err_mm = 1e3 * (fast.position_m - ref.position_m)
-    assert np.ptp(ref.position_m) > 0.015
-    assert np.sqrt(np.mean(err_mm ** 2)) < 0.05 and np.max(np.abs(err_mm)) < 0.6
+    linear rig's 18 mm stroke, against RK4 at 0.1 ms (the same within 1e-7 mm as at 20 us): the
+    program it was validated with, 25 s, 0.037 mm RMS, 0.51 mm max, ends before the wire cools
+    back to martensite; on to 45 s, through that return, it is 0.126 mm RMS, 0.91 mm max (found
+    by review). So the rig's default is the reference. (Without the stiffness implicit, 5 ms steps
+    ran into the end stop, 10 mm RMS, and exponential Euler did at any step.)"""
+    kw = dict(LINEAR_PROGRAM, t_end_s=45.0)
+    assert _numerics(make_spec("linear-bias-spring", "open-loop", **kw)) == REF
+    ref = simulate("linear-bias-spring", "open-loop", **kw, dt_s=1e-4)
+    assert ref.xi_wire[-1] > 0.99 and ref.xi_wire[int(25.0 / 1e-3)] < 0.01  # back to martensite after 25 s
+    err_mm = {}
+    for t_end in (25.0, 45.0):
+        fast = simulate("linear-bias-spring", "open-loop", **dict(kw, t_end_s=t_end),
+                        **dict(zip(("method", "dt_s", "pwm"), STIFF)))
+        err_mm[t_end] = 1e3 * (fast.position_m - ref.position_m[:fast.position_m.size])
+    assert np.sqrt(np.mean(err_mm[25.0] ** 2)) < 0.05 and np.max(np.abs(err_mm[25.0])) < 0.6
+    assert np.sqrt(np.mean(err_mm[45.0] ** 2)) > 0.1 and np.max(np.abs(err_mm[45.0])) > 0.8
 
 
 def test_the_algebraic_laws_long_step_on_the_authors_joint():
@@ -191,11 +198,13 @@ def _square(on_s: float, off_s: float, on: str, t_s: float = 8.0) -> str:
     return f"{steps},{t_s:g}:{off}"
 
 
-def test_the_algebraic_law_keeps_the_reference_under_a_fast_switched_program():
-    """With the algebraic law a program's steps must be 0.5 s apart (numerics.PROGRAM_MIN_STEP_S)."""
-    for on_s, off_s, want in ((0.08, 0.02, REF), (4.0, 1.0, STIFF)):
-        program = dict(voltage=_square(on_s, off_s, "0.6", t_s=10.0), drive="duty")
-        assert _numerics(make_spec("linear-bias-spring", "open-loop", t_end_s=12.0, **program)) == want
+def test_the_algebraic_law_refuses_the_long_step_under_a_fast_switched_program():
+    """With the algebraic law a program's steps must be 0.5 s apart (numerics.PROGRAM_MIN_STEP_S);
+    on the authors' joint with the memory rule a faster one gets the edge step."""
+    p = get("authors2020").replace(hysteresis="memory")
+    for on_s, off_s, want in ((0.08, 0.02, EDGE), (4.0, 1.0, LONG)):
+        program = dict(voltage=_square(on_s, off_s, "8:0", t_s=10.0))
+        assert _numerics(make_spec(p, "open-loop", t_end_s=12.0, **program)) == want
 
 
 def test_whole_wire_heating_keeps_the_reference():
