@@ -204,7 +204,7 @@ def test_fitted_runs_without_a_baseline_are_judged_by_their_residuals(tmp_path):
 def test_a_parameter_the_runs_barely_see_is_not_determined(tmp_path):
     """A step whose wire cools too little to reach the martensite band hardly sees M_S0_C and
     M_F0_C: they got standard errors of 3e9 and 2.5e10 degC on 30 degC bounds, rank_deficient
-    false and no warning (found by review). A standard error wider than the bounds now counts as
+    false and no warning (found by review). A standard error ten times the bounds' width now counts as
     not determined: infinite (null in the report), rank_deficient, and a warning naming them."""
     truth = LINEAR.replace(A_S0_C=71.66, M_S0_C=55.7, eps_R=0.013, h0_heating_W_m2K=40.6, h0_cooling_W_m2K=32.3)
     truth.save(tmp_path / "truth.toml")

@@ -103,6 +103,16 @@ def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes,
         assert ms == pytest.approx(5.0 * steps, rel=0.01) and f"fewer than {MIN_BAND_STEPS} long steps" in why
 
 
+@pytest.mark.parametrize("volts, want", [(20.0, LONG), (30.0, EDGE)])
+def test_the_transformation_band_rule_decides_on_the_joint(volts, want):
+    """The band rule decides for the joint (the rig's long step is refused anyway): at 30 V the
+    paper's wire crosses A_S0 to A_F0 in 78 ms, fewer than 20 long steps, and gets the edge step."""
+    spec = make_spec("paper2010", "open-loop", voltage=f"0:{volts:g}:0", t_end_s=4.0)
+    assert _numerics(spec) == want
+    why = long_step_refusal(spec.params, spec.controller, spec.t_end_s, spec.voltage)
+    assert (why is None) == (want == LONG) and (why is None or "fewer than 20 long steps" in why)
+
+
 def test_other_gains_keep_the_default_within_the_budget():
     """The period-averaged PWM at the long step put the full cycle's reach times 0.1-0.5 s late
     with other PID gains (K_V 300: 2.5 deg RMS, 11.9 deg max from rk4 at 0.1 ms; found by review):

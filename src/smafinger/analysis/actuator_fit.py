@@ -17,7 +17,8 @@ profiled out):
 Uncertainties: the Jacobian at the solution, in the fitted values and the offsets jointly,
 and the residuals give the covariance of :func:`~.fit_uncertainty.covariance`: AR(1)
 residuals per run (sandwich), with the independent-residual one beside it. A fitted value the
-runs do not determine (a singular Jacobian, or a standard error wider than its bounds:
+runs do not determine (a singular Jacobian, or a standard error more than
+:data:`~.fit_uncertainty.UNDETERMINED_WIDTHS` times the width of its bounds:
 :func:`~.fit_uncertainty.mark_undetermined`) gets an infinite standard error and a note.
 """
 
@@ -34,7 +35,7 @@ from ..engine.defaults import DEFAULT_DT_S, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 from ..parameters import ParameterSet
 from .actuator_eval import Evaluator
 from .bench_runs import BenchRun
-from .fit_uncertainty import Covariance, covariance, mark_undetermined
+from .fit_uncertainty import UNDETERMINED_WIDTHS, Covariance, covariance, mark_undetermined
 from .free_params import FreeBox, FreeParameter
 
 UNCERTAINTY_METHOD = (
@@ -223,7 +224,8 @@ def local_stage(ev: Evaluator, u0: np.ndarray, s: FitSettings) -> tuple[np.ndarr
 
 def uncertainty(ev: Evaluator, u: np.ndarray, s: FitSettings) -> tuple[Covariance, np.ndarray]:
     """Covariance of (fitted values, offsets) at u, and the offsets there; a value whose standard
-    error exceeds the width of its bounds is marked not determined (infinite)."""
+    error exceeds UNDETERMINED_WIDTHS times the width of its bounds is marked not determined
+    (infinite)."""
     Jm, centre = ev.model_jacobian(u, s.diff_step)
     n = ev.box.n
     blocks = [Jm]
@@ -279,7 +281,8 @@ def fit_actuator(runs: Sequence[BenchRun], box: FreeBox, pool, settings: FitSett
         labels = list(names) + ([f"the offset of {f}" for f in files] if settings.fit_offsets else [])
         lost = [k for k, bad in zip(labels, cov.undetermined) if bad]
         notes.append(f"not determined by these runs: {', '.join(lost)} (a singular Jacobian, or a standard error "
-                     "wider than the bounds): standard error infinite (null in the report)")
+                     f"more than {UNDETERMINED_WIDTHS:g} times the width of the bounds): standard error infinite "
+                     "(null in the report)")
     if start_eval.failures:
         notes.append(f"the start set failed on a run ({start_eval.failures[0]})")
     if log["status"] == 0 or log["evaluations"] >= settings.max_nfev:

@@ -175,7 +175,8 @@ def misfit_notes(predictions: Sequence[RunPrediction], p: ParameterSet) -> list[
 
     With a baseline noise measured (:func:`role_summary`), the RMS is judged against it
     (:data:`MISFIT_WARN`). Without (no fitted run has :data:`~.bench_runs.MIN_NOISE_SAMPLES`
-    samples at rest before its drive), that is said, and the residuals' shape judges instead:
+    samples at rest before its drive, or those read one value: a quantized sensor, noise 0),
+    that is said, and the residuals' shape judges instead:
     a fitted run whose residuals have a lag-1 autocorrelation above :data:`RHO_MISFIT` is a
     curve the model misses, not noise. (With a noise measured, rho is not used: a sensor's own
     filtering also makes its noise slow.)

@@ -18,7 +18,7 @@ misfit shows as rho near 1 and widens C by up to sqrt((1 + rho) / (1 - rho)) in 
 
 A quantity the data do not determine gets an infinite variance: one in a direction J^T J does
 not see (:func:`null_directions`), and, where the quantities have bounds, one whose standard
-error exceeds the width of its bounds (:func:`mark_undetermined`).
+error exceeds :data:`UNDETERMINED_WIDTHS` times the width of its bounds (:func:`mark_undetermined`).
 """
 
 from __future__ import annotations

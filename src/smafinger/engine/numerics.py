@@ -43,8 +43,9 @@ from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S
 #: holds (docs/speed.md).
 PROGRAM_MIN_STEP_S = 0.5
 #: the long step needs at least this many steps across the transformation band (A_S0 to A_F0)
-#: at the run's strongest drive (:func:`_fast_transformation`). Measured on the linear rig in
-#: open loop against RK4 at 0.1 ms (position RMS / max, peak stress): the validated drives
+#: at the run's strongest drive (:func:`_fast_transformation`; it decides for the joint only now,
+#: the rig's long step being refused). Measured on the linear rig in open loop before that,
+#: against RK4 at 0.1 ms (position RMS / max, peak stress): the validated drives
 #: cross it in 45.5 steps (0.05 / 0.51 mm over an 18 mm stroke, 48 against 46 MPa) and 25.5
 #: (0.07 / 0.95 mm); 13.8 steps gave 2.0 mm max, 8.6 steps 0.7 mm over a 3.6 mm stroke and
 #: 54 against 43 MPa, and 3-6 steps a false trajectory (the slider between its end stops, 741-855
