@@ -140,6 +140,20 @@ def test_a_stress_root_above_the_first_bracket_is_found():
     assert float(np.min(r.sigma_wire_Pa)) >= 0.0
 
 
+@pytest.mark.parametrize("numerics", [{}, {"method": "rk4", "dt_s": 1e-3}])  # the long step, the reference
+def test_a_target_met_at_its_segments_start_is_reached_there(numerics):
+    """The band was checked only at step ends: a target met from its segment's start was entered
+    one step late (5 ms at the long step), every reach segment after it started a step late, and
+    metrics.time_to_reach said 0 on the same samples (found by review)."""
+    from smafinger.metrics import time_to_reach
+
+    r = simulate("paper2010", "cooperative", "0:-40,0.5:-40,reach:-40", t_end_s=2.0, hold_s=0.2, **numerics)
+    assert np.all(r.theta_deg == -40.0)  # at rest on every target
+    assert r.segment_reached_s.tolist() == [0.0, 0.0, 0.0]
+    assert r.segment_start_s[2] == pytest.approx(0.5 + 0.2, abs=1e-12)  # the hold after the second start
+    assert time_to_reach(r.t, r.theta_deg, -40.0, 0.0, 0.5, 0.5, 0.2) == 0.0
+
+
 def test_a_segment_that_never_starts_has_no_start_time():
     """Its start was -1e-9 s (the kernel's -1 marker times the tick), a time API users read as one
     (found by review)."""

@@ -228,6 +228,10 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
             geom = geometry_at(y.q, geom_q, geom, model)
             geom_q = y.q
             s, started = advance(s, t, segs, seg_actual, run.strategy, run.wait_release, model, y, inputs, geom)
+            if started and s.band_since < 0:  # a target met at its start is entered there, not a step on
+                s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks, t, y.q, False)
+                if reached >= 0:
+                    seg_reached[s.next_seg - 1] = reached
             next_event = _next_event(s, run, segs, prog, prog_i)
         else:
             started = False
