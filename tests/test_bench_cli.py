@@ -260,37 +260,30 @@ def test_a_failure_while_moving_the_outputs_in_puts_the_earlier_ones_back(tmp_pa
     assert _tree(out) == before and [p.name for p in out.iterdir() if p.name.startswith(".")] == []
 
 
-def test_ctrl_c_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch):
-    import smafinger.cli.bench as cli_bench
-
-    def say(msg):
-        if msg.startswith("written to"):
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(cli_bench, "_say", say)
-    out = tmp_path / "out"
-    r = runner.invoke(app, [*QUICK, "--no-figures", "--out", str(out)])
-    assert r.exit_code == 130
-    assert f"interrupted (Ctrl-C) after the outputs were written to {out}" in r.output
-    assert (out / "goals.json").exists()
-
-
-def test_ctrl_c_in_the_teardown_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch):
-    """A Ctrl-C while the pool and the progress display closed, after the files had been moved in,
-    said "no output was written" (found by review)."""
+@pytest.mark.parametrize("where", ["printing", "teardown"])
+def test_ctrl_c_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch, where):
+    """A Ctrl-C once the files were moved in, while the result was printed or while the pool and
+    the progress display closed, said "no output was written" (the teardown: found by review)."""
     import contextlib
 
     import smafinger.cli.bench as cli_bench
 
-    real = cli_bench.progress_display
+    if where == "printing":
+        def say(msg):
+            if msg.startswith("written to"):
+                raise KeyboardInterrupt
 
-    @contextlib.contextmanager
-    def interrupted_on_close(progress):
-        with real(progress) as display:
-            yield display
-        raise KeyboardInterrupt  # the teardown, once the body (the runs and the files) is done
+        monkeypatch.setattr(cli_bench, "_say", say)
+    else:
+        real = cli_bench.progress_display
 
-    monkeypatch.setattr(cli_bench, "progress_display", interrupted_on_close)
+        @contextlib.contextmanager
+        def interrupted_on_close(progress):
+            with real(progress) as display:
+                yield display
+            raise KeyboardInterrupt  # the teardown, once the body (the runs and the files) is done
+
+        monkeypatch.setattr(cli_bench, "progress_display", interrupted_on_close)
     out = tmp_path / "out"
     r = runner.invoke(app, [*QUICK, "--no-figures", "--out", str(out)])
     assert r.exit_code == 130

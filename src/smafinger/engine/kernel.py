@@ -185,6 +185,19 @@ def _duties_finite(cmds):
 
 
 @njit(cache=True, forceinline=True)
+def _advance(s, t, segs, seg_actual, seg_reached, run, model, y, inputs, geom):
+    """The schedule at tick t (:func:`.schedule.advance`), with a target met at its segment's
+    start entered there, not at the first step's end (found by review: reached a step late, and
+    every reach segment after it started a step late). Returns (schedule, started)."""
+    s, started = advance(s, t, segs, seg_actual, run.strategy, run.wait_release, model, y, inputs, geom)
+    if started and s.band_since < 0:
+        s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks, t, y.q, False)
+        if reached >= 0:
+            seg_reached[s.next_seg - 1] = reached
+    return s, started
+
+
+@njit(cache=True, forceinline=True)
 def _step_event(s, run, t, next_event, locate):
     """The next event a step must end at: the scheduled one or, with long steps (``locate``), the
     tick at which the target will count as reached if that comes first."""
@@ -227,11 +240,7 @@ def run_kernel(model, run, segs, prog, mech_out, wire_out, seg_actual, seg_reach
         if _segment_due(s, t, segs.start) or s.waiting:
             geom = geometry_at(y.q, geom_q, geom, model)
             geom_q = y.q
-            s, started = advance(s, t, segs, seg_actual, run.strategy, run.wait_release, model, y, inputs, geom)
-            if started and s.band_since < 0:  # a target met at its start is entered there, not a step on
-                s, reached = track_reach(s, t, y.q, run.tol, run.hold_ticks, t, y.q, False)
-                if reached >= 0:
-                    seg_reached[s.next_seg - 1] = reached
+            s, started = _advance(s, t, segs, seg_actual, seg_reached, run, model, y, inputs, geom)
             next_event = _next_event(s, run, segs, prog, prog_i)
         else:
             started = False
