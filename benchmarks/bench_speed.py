@@ -67,8 +67,10 @@ from oracle import simulate_baseline  # noqa: E402
 CASES = (
     ("paper2010 co-operative full cycle", "paper2010", "cooperative", "0:-25,reach:-55,reach:-40", 45.0),
     ("linear bias-spring rig, closed loop", "linear-bias-spring", "cooperative", "0:0.010,15:0.004", 30.0),
+    # 45 s: through the wire's return to martensite, which the long step misses (to a2b9ef5 the
+    # case ended at 25 s, before it, and showed the long step within the budget)
     ("linear bias-spring rig, open loop", "linear-bias-spring", "open-loop",
-     dict(voltage="0:0.6,6:0,12:0.4,18:0", drive="duty"), 25.0),
+     dict(voltage="0:0.6,6:0,12:0.4,18:0", drive="duty"), 45.0),
     ("authors2020 profile 2", "authors2020", "independent", "0:-25:upper,5:-55:both", 20.0),
     ("authors2020 with the memory rule, open loop", "authors2020+memory", "open-loop",
      dict(voltage="0:8:0,4:0:0,8:0:8,12:0:0"), 16.0),
