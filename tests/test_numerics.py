@@ -25,8 +25,9 @@ def _numerics(spec):
 
 LONG = (LONG_STEP.method, LONG_STEP.dt_s, LONG_STEP.pwm)
 STIFF = (LONG_STEP_STIFF.method, LONG_STEP_STIFF.dt_s, LONG_STEP_STIFF.pwm)
-#: the linear rig in open loop: heat, cool, heat less, cool (duty of the supply), 25 s
-LINEAR_PROGRAM = dict(voltage="0:0.6,6:0,12:0.4,18:0", drive="duty", t_end_s=25.0)
+#: the linear rig in open loop: heat, cool, heat less, cool (duty of the supply), on through the
+#: wire's return to martensite (near 25-28 s)
+LINEAR_PROGRAM = dict(voltage="0:0.6,6:0,12:0.4,18:0", drive="duty", t_end_s=45.0)
 REF = (REFERENCE.method, REFERENCE.dt_s, REFERENCE.pwm)
 EDGE = (EDGE_STEP.method, EDGE_STEP.dt_s, EDGE_STEP.pwm)
 
@@ -58,8 +59,8 @@ def _within_budget(got, ref, min_travel_deg: float) -> None:
     (dict(params="paper2010", strategy="cooperative", profile="0:-30", controller="fuzzy-pid"), REF),
     (dict(params="paper2010", strategy="cooperative", profile="0:-30", controller="resistance"), REF),
     (dict(params="linear-bias-spring", strategy="cooperative", profile="0:0.01"), REF),
-    (dict(params="linear-bias-spring", strategy="open-loop", **LINEAR_PROGRAM), REF),
-    (dict(params="linear-bias-spring", strategy="open-loop", voltage="0:0.6,0.2:0", drive="duty"), REF),
+    (dict(params="linear-bias-spring", strategy="open-loop", **LINEAR_PROGRAM), STIFF),
+    (dict(params="linear-bias-spring", strategy="open-loop", voltage="0:0.6,0.2:0", drive="duty"), STIFF),
     (dict(params="authors2020", strategy="open-loop", voltage="0:8:0"), EDGE),
     (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="open-loop", voltage="0:8:0"), LONG),
     (dict(params=get("authors2020").replace(hysteresis="memory"), strategy="independent", profile="0:-25"), EDGE),
@@ -89,7 +90,7 @@ def test_the_default_is_the_long_step_only_where_it_was_validated(kw, want):
 ])
 def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes, program, steps, refused):
     """The linear rig heated across its transformation band in a few long steps gave a false
-    trajectory (24 V: the slider at its end stop, 855 MPa against 122 with rk4 at 0.1 ms; found
+    trajectory (24 V: the slider at its end stop, 839 MPa against 122 with rk4 at 0.1 ms; found
     by review). The band must take MIN_BAND_STEPS long steps at the run's strongest drive."""
     from smafinger.engine.numerics import MIN_BAND_STEPS, _fast_transformation
 
@@ -97,7 +98,7 @@ def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes,
     spec = make_spec(p, "open-loop", voltage=program, drive="duty", t_end_s=8.0)
     why = _fast_transformation(p, spec.voltage)
     assert (why is not None) == refused == (steps < MIN_BAND_STEPS)
-    assert _numerics(spec) == REF  # the rig's long step is refused anyway (its return to martensite)
+    assert _numerics(spec) == (REF if refused else STIFF)
     if refused:
         ms = float(why.split(" in ")[1].split(" ms")[0])
         assert ms == pytest.approx(5.0 * steps, rel=0.01) and f"fewer than {MIN_BAND_STEPS} long steps" in why
@@ -105,7 +106,7 @@ def test_a_transformation_faster_than_the_long_step_keeps_the_reference(changes,
 
 @pytest.mark.parametrize("volts, want", [(20.0, LONG), (30.0, EDGE)])
 def test_the_transformation_band_rule_decides_on_the_joint(volts, want):
-    """The band rule decides for the joint (the rig's long step is refused anyway): at 30 V the
+    """The band rule decides for the joint too: at 30 V the
     paper's wire crosses A_S0 to A_F0 in 78 ms, fewer than 20 long steps, and gets the edge step."""
     spec = make_spec("paper2010", "open-loop", voltage=f"0:{volts:g}:0", t_end_s=4.0)
     assert _numerics(spec) == want
@@ -166,24 +167,22 @@ def test_the_sliding_mode_controllers_default_is_within_the_budget():
     np.testing.assert_allclose(fast.segment_reached_s, ref.segment_reached_s, atol=0.01)
 
 
-def test_the_linear_rigs_long_step_misses_the_return_so_it_is_no_default():
+def test_the_linear_rigs_default_holds_through_the_return_to_martensite():
     """The algebraic stress law's long step (semi-implicit, the wire's stiffness implicit) on the
-    linear rig's 18 mm stroke, against RK4 at 0.1 ms (the same within 1e-7 mm as at 20 us): the
-    program it was validated with, 25 s, 0.037 mm RMS, 0.51 mm max, ends before the wire cools
-    back to martensite; on to 45 s, through that return, it is 0.126 mm RMS, 0.91 mm max (found
-    by review). So the rig's default is the reference. (Without the stiffness implicit, 5 ms steps
-    ran into the end stop, 10 mm RMS, and exponential Euler did at any step.)"""
-    kw = dict(LINEAR_PROGRAM, t_end_s=45.0)
-    assert _numerics(make_spec("linear-bias-spring", "open-loop", **kw)) == REF
-    ref = simulate("linear-bias-spring", "open-loop", **kw, dt_s=1e-4)
+    linear rig's 18 mm stroke, against RK4 at 0.1 ms (the same within 1e-7 mm as at 20 us), over
+    heating and the wire's return to martensite near M_S0 after 25 s: measured 0.0078 mm RMS,
+    0.047 mm max. Before the stiffness was taken on the side the slider moves to, at the wires the
+    step leaves (integrators.implicit_load), each step ended one step of transformation behind
+    (3.4 MPa), the return lagged: 0.126 mm RMS, 0.91 mm max (found by review), and the rig kept
+    the reference. (Without the stiffness implicit, 5 ms steps ran into the end stop, 10 mm RMS,
+    and exponential Euler did at any step.)"""
+    fast = simulate("linear-bias-spring", "open-loop", **LINEAR_PROGRAM)
+    ref = simulate("linear-bias-spring", "open-loop", **LINEAR_PROGRAM, dt_s=1e-4)
+    assert _numerics(fast.spec) == STIFF
     assert ref.xi_wire[-1] > 0.99 and ref.xi_wire[int(25.0 / 1e-3)] < 0.01  # back to martensite after 25 s
-    err_mm = {}
-    for t_end in (25.0, 45.0):
-        fast = simulate("linear-bias-spring", "open-loop", **dict(kw, t_end_s=t_end),
-                        **dict(zip(("method", "dt_s", "pwm"), STIFF)))
-        err_mm[t_end] = 1e3 * (fast.position_m - ref.position_m[:fast.position_m.size])
-    assert np.sqrt(np.mean(err_mm[25.0] ** 2)) < 0.05 and np.max(np.abs(err_mm[25.0])) < 0.6
-    assert np.sqrt(np.mean(err_mm[45.0] ** 2)) > 0.1 and np.max(np.abs(err_mm[45.0])) > 0.8
+    err_mm = 1e3 * (fast.position_m - ref.position_m)
+    assert np.ptp(ref.position_m) > 0.015
+    assert np.sqrt(np.mean(err_mm ** 2)) < 0.02 and np.max(np.abs(err_mm)) < 0.1
 
 
 def test_the_algebraic_laws_long_step_on_the_authors_joint():
@@ -208,13 +207,23 @@ def _square(on_s: float, off_s: float, on: str, t_s: float = 8.0) -> str:
     return f"{steps},{t_s:g}:{off}"
 
 
-def test_the_algebraic_law_refuses_the_long_step_under_a_fast_switched_program():
-    """With the algebraic law a program's steps must be 0.5 s apart (numerics.PROGRAM_MIN_STEP_S);
-    on the authors' joint with the memory rule a faster one gets the edge step."""
-    p = get("authors2020").replace(hysteresis="memory")
-    for on_s, off_s, want in ((0.08, 0.02, EDGE), (4.0, 1.0, LONG)):
-        program = dict(voltage=_square(on_s, off_s, "8:0", t_s=10.0))
-        assert _numerics(make_spec(p, "open-loop", t_end_s=12.0, **program)) == want
+@pytest.mark.parametrize("params, on, window, budget", [
+    ("linear-bias-spring", "0.6", 30.0, (0.05, 0.6)),  # mm: measured 0.021 / 0.36 at a 0.1 s period
+    (get("authors2020").replace(hysteresis="memory"), "8:0", 14.0, (0.05, 0.3)),  # deg: 0.0052 / 0.034
+])
+def test_the_algebraic_laws_long_step_holds_a_fast_switched_program(params, on, window, budget):
+    """An 80 % square wave of 0.1 s period keeps the long step with the algebraic law too, within
+    the budget against RK4 at 0.1 ms. (A program's steps had to be 0.5 s apart while the rig's
+    return lagged: 0.053-0.059 mm RMS, 0.51-0.85 mm max for such waves then.)"""
+    drive = {"drive": "duty"} if params == "linear-bias-spring" else {}
+    kw = dict(voltage=_square(0.08, 0.02, on, t_s=8.0), t_end_s=window, **drive)
+    got = simulate(params, "open-loop", **kw)
+    ref = simulate(params, "open-loop", **kw, dt_s=1e-4)
+    assert _numerics(got.spec) in (LONG, STIFF)
+    coordinate = (lambda r: 1e3 * r.position_m) if params == "linear-bias-spring" else (lambda r: r.theta_deg)
+    err = coordinate(got) - np.interp(got.t, ref.t, coordinate(ref))
+    assert np.ptp(coordinate(ref)) > 5.0
+    assert np.sqrt(np.mean(err ** 2)) < budget[0] and np.max(np.abs(err)) < budget[1]
 
 
 def test_whole_wire_heating_keeps_the_reference():

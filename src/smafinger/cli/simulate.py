@@ -15,11 +15,10 @@ from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 
 #: the default of --dt, --method and --pwm (engine.numerics), told once, under --method
 NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step, {LONG_STEP_DT_S:g} s, "
-                 f"{LONG_STEP_PWM}, where validated (the memory rule; with the algebraic law "
-                 f"a program with steps 0.5 s apart or more): "
+                 f"{LONG_STEP_PWM}, where validated (the memory rule): "
                  f"{LONG_STEP_METHOD} for the finger joint (its rate law with per-metre heating and the paper's "
-                 f"PID, sliding-mode or open loop; the algebraic law in open loop; not for the linear rig, whose "
-                 f"{LONG_STEP_STIFF_METHOD} long step misses the wire's return to martensite); a PWM period of 5 ms or "
+                 f"PID, sliding-mode or open loop; the algebraic law in open loop), {LONG_STEP_STIFF_METHOD} for the "
+                 f"linear rig in open loop; a PWM period of 5 ms or "
                  f"less, and the transformation band crossed in 20 long steps or more; "
                  f"else for the finger joint with per-metre heating (any hysteresis rule, PWM period or stress law; "
                  f"open loop, pid, sliding-mode or rapid-heating): {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "

@@ -22,9 +22,8 @@ DEFAULT_PWM = "exact"
 LONG_STEP_DT_S = 5e-3
 LONG_STEP_METHOD = "exponential"
 LONG_STEP_PWM = "averaged"
-#: the slider's long step (engine.numerics.LONG_STEP_STIFF: the wire's stiffness implicit too), a
-#: setting to give, no run's default (engine.numerics.long_step_refusal: it misses the wire's
-#: return to martensite)
+#: the slider's long step (engine.numerics.LONG_STEP_STIFF: the wire's stiffness implicit too), in
+#: open loop (engine.numerics.long_step_refusal)
 LONG_STEP_STIFF_METHOD = "semi-implicit"
 
 #: the engines a single run may use (engine.interpreted); the default comes from ENGINE_ENV, else "auto"

@@ -9,8 +9,8 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
   for the paper's joint): about 1.1 ms (Euler) and 1.5 ms (RK4).
 - ``semi-implicit``: Euler with the damping implicit, q' = v'(new) (symplectic Euler for the
   mechanism): stable at any step against the damping; the next-stiffest mode is about 34 1/s.
-  With the algebraic stress law the wire's stiffness is implicit too (linearized by a forward
-  difference, :func:`load_stiffness`): there the stress follows q at once, and the wire's axial
+  With the algebraic stress law the wire's stiffness is implicit too (linearized by a one-sided
+  difference in the direction of motion, at the wires the step leaves, :func:`implicit_load`): there the stress follows q at once, and the wire's axial
   stiffness against the inertia is a fast, barely damped mode (on the linear rig omega =
   sqrt(kappa) = 527 rad/s at rest in martensite, more as the wire turns stiffer austenite)
   that no explicit update of q holds (Euler and exponential Euler drift off at every step;
@@ -135,39 +135,56 @@ def damping_over(c, h, prev):
 
 
 @njit(cache=True, forceinline=True)
-def load_stiffness(model, y, inputs, k1):
-    """kappa = -d(q'')/dq at the state's v and wire states [1/s^2]: the mechanism's stiffness
-    over its inertia, by a forward difference, >= 0. Only with the algebraic stress law (authors'
-    2020 model), where a wire's stress follows q at once: the wire's axial stiffness against the
-    inertia is then a fast undamped mode (527 rad/s on the linear rig at rest). With the rate law
-    the stress is a state and q'' depends on q through the geometry alone: 0.
+def implicit_load(model, y, h, inputs, k1, wires_end, geom):
+    """(q'' to hold over the step, kappa) for the semi-implicit step with the wire's stiffness
+    implicit: q'' at the start's q and v with the wires as the step leaves them, and kappa =
+    -d(q'')/dq [1/s^2] there, by a one-sided difference in the direction the mechanism moves, >= 0.
+
+    Only with the algebraic stress law (authors' 2020 model), where a wire's stress follows q at
+    once: the wire's axial stiffness against the inertia is then a fast, barely damped mode (527
+    rad/s on the linear rig at rest). Otherwise (the rate law: the stress is a state and q''
+    depends on q through the geometry alone; or a stuck mechanism): (k1.v, 0).
+
+    Both halves are what the step lands on: the wire's stress at the step's end has taken the
+    step's whole change of temperature (and so of xi), and its stiffness is the one on the side
+    the mechanism moves to. While the wire transforms the two sides differ by far: cooling back to
+    martensite on the linear rig, the wire lengthening takes xi along its branch (16 times softer
+    than the elastic side, where the return-point memory holds xi). A forward difference at the
+    start's wires took the elastic side whatever the motion, and every step ended with the stress
+    one step of transformation behind (3.4 MPa, 0.33 degC of transformation temperature at
+    c_M 10.3 MPa/degC): the return lagged by up to 0.91 mm over the 18 mm stroke
+    (docs/speed.md).
     """
     if model.options.stress_law != StressLaw.ALGEBRAIC or inputs.stuck:
-        return 0.0
+        return k1.v, 0.0
+    start = State(y.q, y.v, y.error_integral, wires_end)
+    k0, _ = derivative(start, inputs, model, geom)
     dq = 1e-7 * (1e-3 + abs(y.q))  # a relative step near sqrt(machine epsilon) of q [rad or m]
+    if y.v + h * k0.v < 0.0:  # the side the explicit step would move to
+        dq = -dq
     q = y.q + dq
-    k, _ = derivative(State(q, y.v, y.error_integral, y.wires), inputs, model, geometry(model, q))
-    return max(0.0, -(k.v - k1.v) / dq)
+    k, _ = derivative(State(q, y.v, y.error_integral, wires_end), inputs, model, geometry(model, q))
+    return k0.v, max(0.0, -(k.v - k0.v) / dq)
 
 
 @njit(cache=True, forceinline=True)
-def _damped_mechanism(method, y, k1, h, c, kappa, damp):
+def _damped_mechanism(method, y, dq_dt, a, h, c, kappa, damp):
     """(q, v) after h with the viscous damping c = C_DF / I treated implicitly or exactly.
 
-    v' = a - c v with a = k1.v + c v held over the step. ``semi-implicit``: v1 = v + h k1.v /
-    (1 + c h), q1 = q + h v1; with a stiffness kappa > 0 (a = a0 - kappa (q - q0)),
-    v1 = v + h (k1.v - kappa h v) / (1 + c h + kappa h^2). ``exponential``: v1 = v +
-    h phi1(-c h) k1.v and q1 = q + h q' + h^2 phi2(-c h) k1.v (exact for a constant a), with
-    phi1, phi2 from ``damp`` (:func:`damping_over` of c and h). A stuck mechanism has
-    q' = v' = 0: it stays.
+    ``dq_dt``, ``a``: q' and q'' (k1's, or :func:`implicit_load`'s q''). v' = a0 - c v with
+    a0 = a + c v held over the step. ``semi-implicit``: v1 = v + h a / (1 + c h), q1 = q + h v1;
+    with a stiffness kappa > 0 (a = a0 - kappa (q - q0)), v1 = v + h (a - kappa h v) /
+    (1 + c h + kappa h^2). ``exponential``: v1 = v + h phi1(-c h) a and q1 = q + h q' +
+    h^2 phi2(-c h) a (exact for a constant a0), with phi1, phi2 from ``damp``
+    (:func:`damping_over` of c and h). A stuck mechanism has q' = v' = 0: it stays.
     """
     if method == Method.SEMI_IMPLICIT:
         if kappa > 0.0:  # the stiffness implicit too: v1 (1 + c h + kappa h^2) = v (1 + c h) + h q''
-            dv = h * (k1.v - kappa * h * y.v) / (1.0 + c * h + kappa * h * h)
+            dv = h * (a - kappa * h * y.v) / (1.0 + c * h + kappa * h * h)
         else:
-            dv = h * k1.v / (1.0 + c * h)
-        return y.q + h * (k1.q + dv), y.v + dv
-    return y.q + h * k1.q + h * h * damp.phi2 * k1.v, y.v + h * damp.phi1 * k1.v
+            dv = h * a / (1.0 + c * h)
+        return y.q + h * (dq_dt + dv), y.v + dv
+    return y.q + h * dq_dt + h * h * damp.phi2 * a, y.v + h * damp.phi1 * a
 
 
 @njit(cache=True, forceinline=True)
@@ -203,12 +220,12 @@ def step(method, model, y, h, inputs, k1, aux, geom, stages, damp):
     if method == Method.SEMI_IMPLICIT or method == Method.EXPONENTIAL:
         ye = axpy(y, h, k1)
         c = inputs.viscous / model.dynamics.inertia
-        kappa = 0.0
+        a, kappa = k1.v, 0.0
         if method == Method.SEMI_IMPLICIT:
-            kappa = load_stiffness(model, y, inputs, k1)
+            a, kappa = implicit_load(model, y, h, inputs, k1, ye.wires, geom)
         else:
             damp = damping_over(c, h, damp)
-        q, v = _damped_mechanism(method, y, k1, h, c, kappa, damp)
+        q, v = _damped_mechanism(method, y, k1.q, a, h, c, kappa, damp)
         wires = _wires_at_mean_rate(ye.wires, aux, (q - y.q) - h * k1.q)
         return State(q, v, ye.error_integral, wires), 0, inputs, damp
     half = 0.5 * h
