@@ -185,6 +185,12 @@ def test_validate_files_are_predicted_not_fitted(real_curves, tmp_path):
     assert d["leave_one_out"] == []
     # the held-out level is predicted as well as the leave-one-out check does
     assert next(f["rms_strain"] for f in d["files"] if f["role"] == "validated") < 2.6e-3
+    # each curve's fitted offset: the report's, in its file entry, and printed (it was in the JSON only)
+    for f in d["files"]:
+        if f["role"] == "fitted":
+            assert f["offset_strain"] == d["offsets"][f["path"]]
+        line = next(ln for ln in r.stdout.splitlines() if Path(f["path"]).name in ln and f["role"] in ln)
+        assert line.endswith(f"offset {100 * f['offset_strain']:+.3f}%") and 0.0 < f["offset_strain"] < 5e-3
 
 
 @real_data

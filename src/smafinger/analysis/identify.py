@@ -88,9 +88,10 @@ def identify_kinetics(files: Sequence[Path], validate: Sequence[Path], base, bas
     names = ", ".join(c.name for c in fitted)
     toml = _toml(values, base_spec, "kinetics", names)
     files_rep = [{"path": c.path, "role": "fitted", "stress_MPa": c.stress_MPa_mean, "n_points": c.n,
-                  "rms_strain": fit.rms[c.path]} for c in fitted]
+                  "rms_strain": fit.rms[c.path], "offset_strain": fit.offsets[c.path]} for c in fitted]
     files_rep += [{"path": c.path, "role": "validated", "stress_MPa": c.stress_MPa_mean, "n_points": c.n,
-                   "rms_strain": kf.rms_strain(fit.params, c, stress)} for c in validated]
+                   "rms_strain": kf.rms_strain(fit.params, c, stress),
+                   "offset_strain": kf.curve_offset(fit.params, c, stress)} for c in validated]
     report = {**fit.to_dict(), "files": files_rep,
               "leave_one_out": [{k: v for k, v in d.items() if k != "params"} for d in loo_res],
               "plausible": not problems, "problems": problems, "at_bounds": fit.at_bounds, "wall_s": wall}
@@ -99,9 +100,10 @@ def identify_kinetics(files: Sequence[Path], validate: Sequence[Path], base, bas
     for k in fit.fitted:
         lines.append(f"  {k:<14} = {_fmt(values[k]):>11} +- {fit.stderr[k]:<9.3g} (+- {fit.stderr_ar1[k]:.3g} "
                      f"allowing for correlated residuals) {unit_of(k)}".rstrip())
-    lines.append("RMS strain error per curve:")
+    lines.append("RMS strain error per curve (and its fitted strain offset, the austenite level in its zero):")
     lines += [f"  {Path(d['path']).name:<28} {d['stress_MPa']:7.1f} MPa  {d['role']:<9}  "
-              f"{d['rms_strain']:.3e} ({100 * d['rms_strain']:.3f}% strain)" for d in files_rep]
+              f"{d['rms_strain']:.3e} ({100 * d['rms_strain']:.3f}% strain)  "
+              f"offset {100 * d['offset_strain']:+.3f}%" for d in files_rep]
     if loo_res:
         lines.append("leave-one-level-out (fit on the others, predict this one):")
         lines += [f"  {Path(d['path']).name:<28} {d['stress_MPa']:7.1f} MPa  predicted  "
