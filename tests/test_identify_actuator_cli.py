@@ -30,6 +30,7 @@ def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("runs")
     truth = LINEAR.replace(A_S0_C=71.0)
     bs.write_csv(d / "a.csv", bs.open_loop_run(truth, "0:0,0.2:0.5,2:0", 4.0, noise=2e-5, offset=1e-3, seed=1))
+    (d / "copy.csv").write_bytes((d / "a.csv").read_bytes())  # the same run under another name
     bs.write_csv(d / "joint.csv", bs.open_loop_run(JOINT, "0:0:0,0.2:0.6:0", 1.0, seed=2))
     (d / "notes.txt").write_text("not a run\n")
     return d
@@ -51,6 +52,9 @@ def refused(result, text):
     # the same file spelled two ways: a 'held-out' run that was fitted (found by review)
     (["--fit", "{d}/a.csv", "--validate", "{d}/./a.csv"], "given twice (as '{d}/a.csv' and '{d}/./a.csv')"),
     (["--fit", "{d}/a.csv", "--fit", "{d}/../{n}/a.csv"], "given twice"),
+    # a copy under another name: fitted twice it weighs double; validated it is not held out
+    (["--fit", "{d}/a.csv", "--validate", "{d}/copy.csv"], "{d}/copy.csv: the same data as {d}/a.csv (every sample equal)"),
+    (["--fit", "{d}/a.csv", "--fit", "{d}/copy.csv"], "the same data as"),
     (["--fit", "{d}/a.csv", "--map", "duty=u*abc"], "'abc' after '*'"),
     (["--fit", "{d}/a.csv::duty=u_pwm"], "mapping duty=u_pwm: no column 'u_pwm'"),
     (["--fit", "{d}/a.csv", "--free", "A_S0_C:90:95"], "start value 68"),

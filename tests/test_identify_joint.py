@@ -159,3 +159,20 @@ def test_a_curve_logged_from_a_later_time_is_refused_not_fitted(tmp_path):
     assert len(r.stderr.strip().splitlines()) == 1
     assert f"{late}: row 1 (line 2): time 100 s of the first row is after 0" in r.stderr
     assert not out.exists()
+
+
+def test_a_curve_given_twice_or_copied_under_another_name_is_refused(tmp_path):
+    """A curve given twice weighs double, as the same file or as a copy under another name.
+    Exit 2, one line naming both, nothing written."""
+    heat = write_csv(tmp_path / "heat.csv", synthesize(TRUTH, "0:5:0", 5.0, SAMPLE_S, NOISE_DEG, seed=11))
+    copy = tmp_path / "heat_copy.csv"
+    copy.write_bytes(heat.read_bytes())
+    cool = write_csv(tmp_path / "cool.csv", synthesize(TRUTH, "0:8:0,1:0:0", 3.0, SAMPLE_S, NOISE_DEG, seed=12))
+    out = tmp_path / "fit.toml"
+    for second in (heat, copy):
+        r = CliRunner().invoke(app, ["joint", "--heating", str(heat), "--heating", str(second), "--cooling", str(cool),
+                                     "--out", str(out), "--no-progress"])
+        assert r.exit_code == 2, r.stderr
+        assert len(r.stderr.strip().splitlines()) == 1
+        assert f"{second}: the same data as {heat} (every sample equal)" in r.stderr, r.stderr
+        assert not out.exists()

@@ -239,6 +239,17 @@ def test_a_curve_fitted_and_validated_or_fitted_twice_is_refused(real_curves):
         assert r.exit_code == 2 and "given twice" in r.stderr, r.stderr
 
 
+def test_a_copy_of_a_curve_under_another_name_is_refused(real_curves, tmp_path):
+    """A copy of a fitted file given to validate is not held out; fitted twice, it weighs double.
+    Exit 2, naming both."""
+    path = Path(real_curves[0].path)
+    copy = tmp_path / "copy.txt"
+    copy.write_bytes(path.read_bytes())
+    for args in ([str(path), "--validate", str(copy)], [str(path), str(copy)]):
+        r = CliRunner().invoke(app, ["kinetics", *[c.path for c in real_curves[1:3]], *args, "--no-progress"])
+        assert r.exit_code == 2 and f"{copy}: the same data as {path} (every sample equal)" in r.stderr, r.stderr
+
+
 def test_a_closed_stdout_does_not_cost_the_fit(real_curves, tmp_path):
     """`identify kinetics ... --out fit.toml | head -1`: the fit's lines were printed before its
     files were written, so a closed pipe lost them (found by review); now they are written first."""

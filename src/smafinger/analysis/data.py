@@ -144,6 +144,26 @@ class StrainCurve:
 KINETICS_COLUMNS = ("temperature", "strain", "stress")
 
 
+def same_data(named) -> str | None:
+    """Why two of ``named``, (label, arrays) pairs, are one data set under two names, or None:
+    every array of one equal to the other's (shape and every value). A copy fitted twice weighs
+    double, and a copy of a fitted file given to validate is not held out."""
+    import hashlib
+
+    seen: dict[str, str] = {}
+    for label, arrays in named:
+        digest = hashlib.sha256()
+        for a in arrays:
+            a = np.ascontiguousarray(a, dtype=np.float64)
+            digest.update(repr(a.shape).encode() + a.tobytes())
+        key = digest.hexdigest()
+        if key in seen:
+            return (f"{label}: the same data as {seen[key]} (every sample equal); give each data set once, "
+                    "with one role")
+        seen[key] = label
+    return None
+
+
 def load_strain_curve(path: str | Path) -> StrainCurve:
     """Read and validate a strain-temperature file (see the module docstring)."""
     path = Path(path)

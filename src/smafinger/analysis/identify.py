@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .data import DataError, load_angle_curve, load_strain_curve, parameter_file_text
+from .data import DataError, load_angle_curve, load_strain_curve, parameter_file_text, same_data
 
 #: parameter-name endings -> units, for printing fitted values (the unit is in every name)
 UNIT_SUFFIXES = (("_Pa_per_C", "Pa/degC"), ("_W_m2K3", "W/(m^2 K^3)"), ("_W_m2K", "W/(m^2 K)"), ("_Nms", "N m s"),
@@ -71,6 +71,8 @@ def identify_kinetics(files: Sequence[Path], validate: Sequence[Path], base, bas
 
     fitted = [load_strain_curve(f) for f in files]
     validated = [load_strain_curve(f) for f in validate]
+    if (copy := same_data((c.path, (c.T_C, c.strain, c.stress_Pa)) for c in fitted + validated)) is not None:
+        raise DataError(copy)
     t0 = time.perf_counter()
     moduli = ("D_M",) if fit_moduli else ()
     n_loo = len(fitted) if (loo and len(fitted) >= 3) else 0
@@ -133,6 +135,8 @@ def joint_experiments(heating: Sequence[Path], cooling: Sequence[Path], heat_s: 
                         f"per cooling file, in the same order, or none (voltage columns)")
     h_curves = [load_angle_curve(f) for f in heating]
     c_curves = [load_angle_curve(f) for f in cooling]
+    if (copy := same_data((c.path, (c.t_s, c.angle_deg)) for c in h_curves + c_curves)) is not None:
+        raise DataError(copy)
     try:
         return ([(c, jf.heating_program(c, heating_voltage)) for c in h_curves],
                 [(c, jf.cooling_program(c, cooling_voltage, heat_s[i] if heat_s else None))

@@ -95,6 +95,7 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     from ..analysis import actuator_report as ar
     from ..analysis.actuator_fit import FitSettings
     from ..analysis.bench_runs import load_closed_loop, load_open_loop
+    from ..analysis.data import same_data
     from ..analysis.free_params import FreeBox, parse_free
     from ..parameters import REGISTRY, resolve
     from ..recordings import parse_map_options
@@ -125,6 +126,9 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     runs += [load_open_loop(*_run_map(a, maps), "validate", p, wire=wire) for a in validate]
     runs += [load_closed_loop(*_run_map(a, maps), p, controller, reference=reference, offset=offset == "per-run")
              for a in replay]
+    if (copy := same_data((r.file, (r.recording.input.t_s, r.recording.input.values, r.recording.output.t_s,
+                                    r.recording.output.values)) for r in runs)) is not None:
+        raise Usage(copy)
     for run in runs if offset == "per-run" else []:
         if run.role == "validate":  # its offset is measured on its baseline (a fitted run's is fitted)
             run.check_baseline()
