@@ -135,14 +135,15 @@ def joint_experiments(heating: Sequence[Path], cooling: Sequence[Path], heat_s: 
                         f"per cooling file, in the same order, or none (voltage columns)")
     h_curves = [load_angle_curve(f) for f in heating]
     c_curves = [load_angle_curve(f) for f in cooling]
-    if (copy := same_data((c.path, (c.t_s, c.angle_deg)) for c in h_curves + c_curves)) is not None:
-        raise DataError(copy)
     try:
-        return ([(c, jf.heating_program(c, heating_voltage)) for c in h_curves],
-                [(c, jf.cooling_program(c, cooling_voltage, heat_s[i] if heat_s else None))
-                 for i, c in enumerate(c_curves)])
+        experiments = ([(c, jf.heating_program(c, heating_voltage)) for c in h_curves],
+                       [(c, jf.cooling_program(c, cooling_voltage, heat_s[i] if heat_s else None))
+                        for i, c in enumerate(c_curves)])
     except ValueError as exc:
         raise DataError(str(exc)) from None
+    if (copy := same_data((c.path, (c.t_s, c.angle_deg)) for c in h_curves + c_curves)) is not None:
+        raise DataError(copy)
+    return experiments
 
 
 def identify_joint(h_exps, c_exps, base, base_spec, fit_msf: bool = False, display=None) -> Identification:
