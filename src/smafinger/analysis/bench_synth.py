@@ -15,7 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..engine.run import DEFAULT_DT_S, simulate
+from ..engine.numerics import reference_dt
+from ..engine.run import simulate
 from ..files import atomic_write
 from ..parameters import ParameterSet
 from ..profiles import TargetProfile, VoltageProgram
@@ -71,7 +72,7 @@ def open_loop_run(p: ParameterSet, duty: str | VoltageProgram, t_end_s: float, *
     """A run driven by a duty program (``"T:DUTY,..."``, a fraction of V_H, on the first wire)."""
     prog = VoltageProgram.parse(duty, "duty") if isinstance(duty, str) else duty
     r = simulate(p, "open-loop", voltage=prog, drive="duty", t_end_s=t_end_s, output_interval_s=SIM_OUTPUT_S,
-                 dt_s=DEFAULT_DT_S, engine="compiled")  # the numerics the fits replay runs with (bench_runs)
+                 dt_s=reference_dt(p), engine="compiled")  # the numerics the fits replay runs with (bench_runs)
     t_in, i_in, t_out, measured = _logged(r, p, t_end_s, input_period_s, output_period_s, noise, offset, seed)
     starts, values = prog.arrays()[0], prog.arrays()[1]
     d = values[np.searchsorted(starts, t_in + 1e-12, side="right") - 1]
@@ -87,7 +88,7 @@ def closed_loop_run(p: ParameterSet, profile: str, controller: RigController, t_
     the logged duty is what the controller sent, the logged reference the target plus ``offset``."""
     prof = TargetProfile.parse(profile)
     r = simulate(controller.apply(p), "cooperative", profile=prof, t_end_s=t_end_s, output_interval_s=SIM_OUTPUT_S,
-                 dt_s=DEFAULT_DT_S, engine="compiled")
+                 dt_s=reference_dt(p), engine="compiled")
     t_in, i_in, t_out, measured = _logged(r, p, t_end_s, input_period_s, output_period_s, noise, offset, seed)
     wire = p.wire_names[0]
     duty = np.round(r.signal(f"duty_{wire}")[i_in] / 100.0 * controller.duty_max, 4)  # a 0.01 % PWM resolution

@@ -17,14 +17,15 @@ from .errors import NOTHING_WRITTEN, UsageError, command, reading_input
 NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step, {LONG_STEP_DT_S:g} s, "
                  f"{LONG_STEP_PWM}, where validated (the memory rule): "
                  f"{LONG_STEP_METHOD} for the finger joint (its rate law with per-metre heating and the paper's "
-                 f"PID, sliding-mode or open loop; the algebraic law in open loop), {LONG_STEP_STIFF_METHOD} for the "
-                 f"linear rig in open loop; a PWM period of 5 ms or "
-                 f"less, and the transformation band crossed in 20 long steps or more; "
+                 f"PID, sliding-mode or open loop; the algebraic law in open loop; not the linear rig, whose "
+                 f"{LONG_STEP_STIFF_METHOD} long step damps the slider's momentum after a drive change); a PWM period "
+                 f"of 5 ms or less, and the transformation band crossed in 20 long steps or more; "
                  f"else for the finger joint with per-metre heating (any hysteresis rule, PWM period or stress law; "
                  f"open loop, pid, sliding-mode or rapid-heating): {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
                  f"{DEFAULT_PWM} (sub-steps at every PWM edge); "
                  f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
-                 f"{DEFAULT_DT_S:g} s, {DEFAULT_PWM}; docs/speed.md]")
+                 f"{DEFAULT_DT_S:g} s (on a slider whose wire-slider mode turns over 1 rad in that: 1 ms / n, "
+                 f"shorter), {DEFAULT_PWM}; docs/speed.md]")
 
 #: options that define the run (refused with --from; --scenario takes some of them)
 RUN_OPTIONS = ("params", "set_", "scenario", "strategy", "profile", "voltage", "duty", "current", "t_end", "dt",

@@ -125,7 +125,8 @@ def fit_calibration(wires: tuple[str, ...], q: np.ndarray, R_ohm: np.ndarray,
 def calibration_numerics(p: ParameterSet):
     """The numerics of the calibration's steps on set ``p`` (an :class:`~smafinger.engine.numerics.Numerics`).
 
-    The reference (RK4, 1 ms, the PWM resolved at its edges), except that a PWM period below
+    The reference (RK4, 1 ms or :func:`~smafinger.engine.numerics.reference_dt`'s shorter step
+    on a stiff slider, the PWM resolved at its edges), except that a PWM period below
     :data:`EXACT_PWM_MIN_PERIOD_S` is averaged (RK4, 1 ms still) where the period-averaged PWM is
     valid for a closed loop of the paper's PID on ``p``: where
     :func:`~smafinger.engine.numerics.long_step_refusal` finds nothing against it, the rule a
@@ -134,11 +135,12 @@ def calibration_numerics(p: ParameterSet):
     the ripple it removes). Elsewhere the PWM stays resolved, up to two sub-steps per period, as in
     the set's own runs at their defaults.
     """
-    from ..engine.numerics import REFERENCE, long_step_refusal
+    from ..engine.numerics import REFERENCE, long_step_refusal, reference_dt
 
+    reference = dataclasses.replace(REFERENCE, dt_s=reference_dt(p))  # shorter on a stiff slider
     if p.pwm_period_s < EXACT_PWM_MIN_PERIOD_S and long_step_refusal(p, None, STEP_S) is None:
-        return dataclasses.replace(REFERENCE, pwm="averaged")
-    return REFERENCE
+        return dataclasses.replace(reference, pwm="averaged")
+    return reference
 
 
 def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strategy: str = "independent",

@@ -5,7 +5,7 @@
 
 # The reference numerics: what a run gets when it sets any of dt_s, method, pwm (the unset ones
 # come from here), and what the paper's scenarios use (the golden record holds their bits).
-#: integration step [s]
+#: integration step [s]; on a stiff slider shorter (engine.numerics.reference_dt)
 DEFAULT_DT_S = 1e-3
 #: classical RK4. Forward Euler at 1 ms is about 3x faster on the co-operative full cycle and
 #: 0.01 deg RMS from a 1 us reference there (benchmarks/bench_core.py), but it blows up on
@@ -22,8 +22,8 @@ DEFAULT_PWM = "exact"
 LONG_STEP_DT_S = 5e-3
 LONG_STEP_METHOD = "exponential"
 LONG_STEP_PWM = "averaged"
-#: the slider's long step (engine.numerics.LONG_STEP_STIFF: the wire's stiffness implicit too), in
-#: open loop (engine.numerics.long_step_refusal)
+#: the slider's long step (engine.numerics.LONG_STEP_STIFF: the wire's stiffness implicit too), a
+#: setting to give, no run's default (engine.numerics.long_step_refusal: the slider's momentum)
 LONG_STEP_STIFF_METHOD = "semi-implicit"
 
 #: the engines a single run may use (engine.interpreted); the default comes from ENGINE_ENV, else "auto"

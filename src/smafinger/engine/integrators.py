@@ -9,10 +9,11 @@ the engine evaluates it at every sub-step start for its discrete decisions anywa
   for the paper's joint): about 1.1 ms (Euler) and 1.5 ms (RK4).
 - ``semi-implicit``: Euler with the damping implicit, q' = v'(new) (symplectic Euler for the
   mechanism): stable at any step against the damping; the next-stiffest mode is about 34 1/s.
-  With the algebraic stress law the wire's stiffness is implicit too (linearized by a one-sided
-  difference in the direction of motion, at the wires the step leaves, :func:`implicit_load`): there the stress follows q at once, and the wire's axial
-  stiffness against the inertia is a fast, barely damped mode (on the linear rig omega =
-  sqrt(kappa) = 527 rad/s at rest in martensite, more as the wire turns stiffer austenite)
+  With the algebraic stress law the wire's stiffness is implicit too (linearized by a forward
+  difference at the wires the step leaves, :func:`implicit_load`): there the stress follows q
+  at once, and the wire's axial stiffness against the inertia is a fast, barely damped mode
+  (on the linear rig omega = sqrt(kappa) = 527 rad/s at rest in martensite, more as the wire
+  turns stiffer austenite)
   that no explicit update of q holds (Euler and exponential Euler drift off at every step;
   semi-implicit without it held 2 ms steps, not 5 ms: 2/omega = 3.8 ms at rest).
 - ``exponential``: exponential Euler for the mechanism: (q, v) advanced exactly under the held
@@ -135,33 +136,29 @@ def damping_over(c, h, prev):
 
 
 @njit(cache=True, forceinline=True)
-def implicit_load(model, y, h, inputs, k1, wires_end, geom):
+def implicit_load(model, y, inputs, k1, wires_end, geom):
     """(q'' to hold over the step, kappa) for the semi-implicit step with the wire's stiffness
-    implicit: q'' at the start's q and v with the wires as the step leaves them, and kappa =
-    -d(q'')/dq [1/s^2] there, by a one-sided difference in the direction the mechanism moves, >= 0.
+    implicit: q'' at the start's q and v with the wires as the explicit step leaves them, and
+    kappa = -d(q'')/dq [1/s^2] there, by a forward difference, >= 0.
 
     Only with the algebraic stress law (authors' 2020 model), where a wire's stress follows q at
     once: the wire's axial stiffness against the inertia is then a fast, barely damped mode (527
     rad/s on the linear rig at rest). Otherwise (the rate law: the stress is a state and q''
     depends on q through the geometry alone; or a stuck mechanism): (k1.v, 0).
 
-    Both halves are what the step lands on: the wire's stress at the step's end has taken the
-    step's whole change of temperature (and so of xi), and its stiffness is the one on the side
-    the mechanism moves to. While the wire transforms the two sides differ by far: cooling back to
-    martensite on the linear rig, the wire lengthening takes xi along its branch (16 times softer
-    than the elastic side, where the return-point memory holds xi). A forward difference at the
-    start's wires took the elastic side whatever the motion, and every step ended with the stress
-    one step of transformation behind (3.4 MPa, 0.33 degC of transformation temperature at
-    c_M 10.3 MPa/degC): the return lagged by up to 0.91 mm over the 18 mm stroke
-    (docs/speed.md).
+    Both at the wires the step leaves: the step then lands where the wire's stress, having taken
+    the step's whole change of temperature and so of xi, holds the load, and the stiffness is
+    the transforming wire's on either side of q. At the start's wires (until 0a71aa2) a wire
+    whose transformation the return-point memory held at the start had its elastic stiffness,
+    16 times the transforming one on the linear rig's return to martensite, and every step ended
+    one step of transformation behind its equilibrium (the stress 3.4 MPa low, 0.33 degC of
+    transformation temperature at c_M 10.3 MPa/degC): the return lagged by up to 0.91 mm over the
+    18 mm stroke (docs/speed.md).
     """
     if model.options.stress_law != StressLaw.ALGEBRAIC or inputs.stuck:
         return k1.v, 0.0
-    start = State(y.q, y.v, y.error_integral, wires_end)
-    k0, _ = derivative(start, inputs, model, geom)
+    k0, _ = derivative(State(y.q, y.v, y.error_integral, wires_end), inputs, model, geom)
     dq = 1e-7 * (1e-3 + abs(y.q))  # a relative step near sqrt(machine epsilon) of q [rad or m]
-    if y.v + h * k0.v < 0.0:  # the side the explicit step would move to
-        dq = -dq
     q = y.q + dq
     k, _ = derivative(State(q, y.v, y.error_integral, wires_end), inputs, model, geometry(model, q))
     return k0.v, max(0.0, -(k.v - k0.v) / dq)
@@ -222,7 +219,7 @@ def step(method, model, y, h, inputs, k1, aux, geom, stages, damp):
         c = inputs.viscous / model.dynamics.inertia
         a, kappa = k1.v, 0.0
         if method == Method.SEMI_IMPLICIT:
-            a, kappa = implicit_load(model, y, h, inputs, k1, ye.wires, geom)
+            a, kappa = implicit_load(model, y, inputs, k1, ye.wires, geom)
         else:
             damp = damping_over(c, h, damp)
         q, v = _damped_mechanism(method, y, k1.q, a, h, c, kappa, damp)

@@ -8,14 +8,16 @@ validated for it against a run at a far shorter step with exact PWM edges:
   model) in open loop;
 - :data:`LONG_STEP_STIFF` on a slider pulled directly by the wire (the linear bias-spring rig,
   algebraic law): semi-implicit Euler with the wire's stiffness implicit too
-  (:func:`.integrators.implicit_load`), 5 ms, period-averaged PWM, in open loop;
+  (:func:`.integrators.implicit_load`), 5 ms, period-averaged PWM: a setting to give, no run's
+  default (:func:`long_step_refusal`: the slider's momentum after a drive change);
 - :data:`EDGE_STEP` on the finger joint where only the average is the trouble (a hysteresis
   rule that follows the PWM ripple, a PWM period longer than the step, the authors' 2020 model in
   closed loop, the rapid-heating controller, a controller at gains other than the ones the long
   step was validated with): exponential Euler with the PWM
   resolved at its edges, so a sub-step ends at every edge and output sample, as with the
   reference, but costs one right-hand side instead of four;
-- the reference settings (RK4, 1 ms, exact PWM) everywhere else.
+- the reference settings (RK4, 1 ms, exact PWM) everywhere else; on a slider, RK4's step is
+  shortened to hold the wire-slider mode (:func:`reference_dt`).
 
 A run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where each holds and why it does not elsewhere: docs/speed.md.
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -36,14 +39,15 @@ from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S
 #: the long step needs at least this many steps across the transformation band (A_S0 to A_F0)
 #: at the run's strongest drive (:func:`_fast_transformation`). Measured on the linear rig in
 #: open loop, full duty for seconds, then cooling through the return to martensite, against RK4
-#: at 0.1 ms (position RMS / max over the 18 mm stroke, peak stress; since the stiffness is taken
-#: on the side the slider moves to, :func:`.integrators.implicit_load`): 45.5 steps (the
+#: at 0.1 ms (position RMS / max over the 18 mm stroke, peak stress; with the stiffness at the
+#: wires the step leaves, :func:`.integrators.implicit_load`, since 0a71aa2): 45.5 steps (the
 #: validated program's strongest drive) 0.008 / 0.047 mm; 25.5 steps (12 V) 0.015 / 0.087;
 #: 13.8 (16 V) 0.021 / 0.23; 12.2 (a 0.5 m wire at 50 %) 0.011 / 0.15; 8.6 (20 V) 0.028 / 0.77,
 #: over the budget (0.05 / 0.6 mm), 50 against 48 MPa; 5.9 (24 V) a false trajectory, the slider
 #: at its end stop, 839 against 122 MPa (found by review), and 2.1 (a 0.3 m wire at 12 V) 426
-#: against 233 MPa. Kept at 20, where it was set before that change. The paper's and the
-#: authors' sets at their drives: 266 and 230 steps.
+#: against 233 MPa. Kept at 20, where it was set before that change; it decides for the joint
+#: (the rig's long step is refused anyway). The paper's and the authors' sets at their drives:
+#: 266 and 230 steps.
 MIN_BAND_STEPS = 20
 
 
@@ -62,7 +66,8 @@ LONG_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
 #: explicit update of the position holds: exponential Euler gave 8.4 mm RMS at 1 ms and 1.5 mm
 #: at 0.1 ms against rk4, symplectic Euler (semi-implicit without kappa) held 2 ms, not 5 ms.
 #: On the joint the series tendon spring and the joint's damping leave exponential Euler
-#: better (authors2020's mechanics, open loop: 0.013 deg RMS against semi-implicit's 0.028)
+#: better (authors2020's mechanics with the memory rule, open loop, against rk4 at 10 us: 0.0128
+#: deg RMS, 0.063 max against semi-implicit's 0.0146, 0.062; 0.028, 0.108 before 0a71aa2)
 LONG_STEP_STIFF = Numerics(LONG_STEP_STIFF_METHOD, LONG_STEP_DT_S, LONG_STEP_PWM)
 #: the joint's integrator and step with the PWM resolved at its edges (:func:`edge_step_refusal`)
 EDGE_STEP = Numerics(LONG_STEP_METHOD, LONG_STEP_DT_S, DEFAULT_PWM)
@@ -111,24 +116,28 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
       :class:`~smafinger.control.params.ControllerParameters`) at the set's own gains, those of
       :data:`LONG_STEP_GAINS_OF` (:func:`_other_gains`; other gains get the edge step), or
       open loop;
-    - the algebraic stress law in open loop: the authors' 2020 joint with the memory rule (0.013
-      deg RMS) and the linear rig, through heating and the return to martensite (its program
-      run to 45 s: 0.008 mm RMS, 0.047 mm max over an 18 mm stroke; duty steps of 15-100 %,
-      6 V, 1.5 A, slider masses of 5-100 g, springs of 20-120 N/m, friction, a 0.5 m wire:
-      within 0.015 mm RMS, 0.19 mm max; docs/speed.md). Before the rig's stiffness was taken on
-      the side it moves to (:func:`.integrators.implicit_load`) the return lagged, 0.13 mm RMS,
-      0.91 mm max (found by review), and the rig kept the reference. Not in closed loop: on the
-      linear rig the closed loop's reach times scatter by seconds between step sizes (RK4 at
-      0.1 ms against 1 us included), so no step can be checked against a converged run;
+    - the algebraic stress law in open loop on the finger joint: the authors' 2020 joint with
+      the memory rule (0.013 deg RMS). Not on the linear rig, whose slider's momentum matters
+      (found by a random search of 2,910 rig runs, 231 over the budget of 0.05 mm RMS, 0.6 mm
+      max; docs/speed.md): the wire against the slider's mass is a mode of 500-900 rad/s on the
+      template, and a drive cut while the wire transforms lets the slider coast on for about
+      1/omega, unloading the wire, which transforms further, and the memory rule keeps it. The
+      long step damps that mode (the template, full duty cut at 0.65 s: 0.22 mm RMS, 0.83 mm
+      max; semi-implicit at 0.1 ms still 0.16 mm max; rk4 at 1 ms 0.003 mm). Fast cooling
+      (h0_cooling 600 W/m^2K: 0.73 mm max), static friction of 0.8 N (0.77 mm max) and a start
+      off the major loop fail too. Through the wire's return to martensite its long step holds
+      since 0a71aa2 (its program run to 45 s: 0.008 mm RMS, 0.047 mm max; it was 0.13, 0.91).
+      Not in closed loop: on the linear rig the closed loop's reach times scatter by seconds
+      between step sizes (RK4 at 0.1 ms against 1 us included), so no step can be checked
+      against a converged run;
     - either law: the return-point-memory hysteresis and a PWM period no longer than the step
       (the average then covers whole periods). An open-loop ``program``
       (:class:`~smafinger.profiles.VoltageProgram`; None in closed loop) may switch at any rate:
       steps end at its switches, and with the wires moved at the mechanism's mean rate over a
       step (:mod:`.integrators`) an 80 % square wave stayed within the budget against rk4 at
       0.1 ms for periods from 2 s down to 5-50 ms: at 8 V on paper2010 0.008 deg RMS, 0.06 deg
-      max; on the authors' joint with the memory rule 0.0093 / 0.072 deg; on the linear rig
-      (60 % duty for 80 % of each period) 0.027 / 0.38 mm. (With the algebraic law a program's steps had to be 0.5 s apart
-      while the rig's return lagged: 0.053-0.059 mm RMS, 0.51-0.85 max there);
+      max; on the authors' joint with the memory rule 0.0093 / 0.072 deg (with the algebraic
+      law a program's steps had to be 0.5 s apart until 0a71aa2, a rule set on the linear rig);
     - a transformation that takes :data:`MIN_BAND_STEPS` long steps or more at the run's
       strongest drive (:func:`_fast_transformation`).
     """
@@ -138,6 +147,10 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
     if opts.hysteresis != Hysteresis.MEMORY:
         return f"hysteresis {opts.hysteresis.label}: its branch follows the PWM ripple the average removes"
     if opts.stress_law == StressLaw.ALGEBRAIC:
+        if params.mechanism != "joint":
+            return (f"mechanism {params.mechanism} with the algebraic stress law: the long step damps the "
+                    "wire-slider mode that carries the slider on after a drive change (0.83 mm max on the template; "
+                    "docs/speed.md)")
         if program is None:
             return ("the algebraic stress law in closed loop: not validated (on the linear rig its reach times scatter "
                     "by seconds between step sizes)")
@@ -261,13 +274,78 @@ def edge_step_refusal(params, controller, t_end_s: float) -> str | None:
     return None
 
 
+#: the reference's RK4 takes at most this many radians of the wire-slider mode a step
+#: (:func:`reference_dt`): the template rig in austenite is 0.90 at 1 ms, where a drive cut
+#: while the wire transforms is within 0.003 mm of rk4 at 0.1 ms
+WIRE_MODE_RAD_PER_STEP = 1.0
+#: RK4's stability bound on an undamped mode, h omega <= 2 sqrt(2) (the authors' solver is RK4;
+#: on a damping's real, negative mode the bounds are plausibility.EXPLICIT_STABILITY's)
+RK4_STABLE_H_OMEGA = 2.0 * 2.0 ** 0.5
+
+
+def wire_mode_omega(params) -> float | None:
+    """omega [rad/s] of the wire against the slider's mass at its stiffest, in austenite:
+    sqrt((D_A A_w / L_w + K_bias) / m). A slider pulled directly by its wire has this fast,
+    barely damped mode (904 rad/s on the template rig; 5,700 on a 0.1 m wire pulling 5 g).
+    None on the finger joint, where the series tendon spring and the joint's inertia and damping
+    keep the fastest mode the damping's (-C_DF/I, about 1.5 ms for RK4)."""
+    if params.mechanism == "joint":
+        return None
+    area = math.pi * params.wire_diameter_m ** 2 / 4.0
+    return math.sqrt((params.D_A_Pa * area / params.wire_length_m + params.bias_spring_K_N_m) / params.slider_mass_kg)
+
+
+def reference_dt(params) -> float:
+    """The reference's step [s]: 1 ms, or on a slider whose wire-slider mode turns more than
+    :data:`WIRE_MODE_RAD_PER_STEP` in 1 ms the longest 1 ms / n (n dividing 10^6, so that the
+    step is a whole number of nanoseconds) that does not. RK4 at 1 ms went unstable there and,
+    held by the end stops, returned a wrong trajectory: a 0.1 m wire pulling 5 g (5,700 rad/s)
+    was 19 mm RMS off rk4 at 10 us over a 1.8 mm stroke."""
+    omega = wire_mode_omega(params)
+    if omega is None or omega * DEFAULT_DT_S <= WIRE_MODE_RAD_PER_STEP:
+        return DEFAULT_DT_S
+    n = next((n for n in _DIVISORS_OF_1MS if omega * DEFAULT_DT_S / n <= WIRE_MODE_RAD_PER_STEP),
+             _DIVISORS_OF_1MS[-1])  # 1 ns at most: a mode beyond that is refused (unstable_step)
+    return DEFAULT_DT_S / n
+
+
+#: the divisors of 10^6 (1 ms in nanoseconds), ascending
+_DIVISORS_OF_1MS = tuple(sorted(2 ** i * 5 ** j for i in range(7) for j in range(7)))
+
+
+def unstable_step(params, method: str, dt_s: float) -> str | None:
+    """Why an explicit method's step cannot hold the run's wire-slider mode (None: it can, or
+    the mechanism has none): RK4 and the authors' solver beyond h omega = 2 sqrt(2); Euler
+    beyond h omega^2 = c, the viscous damping over the mass (forward Euler amplifies a mode
+    damped less than that at every step). Such a run does not blow up: the end stops hold the
+    slider, and the result is wrong (found by review)."""
+    omega = wire_mode_omega(params)
+    if omega is None:
+        return None
+    if method in ("rk4", "authors-ode4") and dt_s * omega > RK4_STABLE_H_OMEGA:
+        limit = RK4_STABLE_H_OMEGA / omega
+    elif method == "euler" and dt_s * omega ** 2 > params.viscous_damping_N_s_m / params.slider_mass_kg:
+        limit = params.viscous_damping_N_s_m / params.slider_mass_kg / omega ** 2
+    else:
+        return None
+    return (f"dt_s = {dt_s:g} is beyond {method}'s stability limit for this slider's wire-slider mode "
+            f"(omega = {omega:.4g} rad/s, the wire in austenite against the slider's mass): use dt_s <= {limit:.3g} "
+            f"or method semi-implicit")
+
+
 def choose(params, controller, t_end_s: float, method: str | None, dt_s: float | None,
            pwm: str | None, program=None) -> Numerics:
-    """The run's numerics: the given values, else the run's default (module docstring)."""
+    """The run's numerics: the given values, else the run's default (module docstring).
+    Raises ``ValueError`` for an explicit step the run's wire-slider mode makes unstable
+    (:func:`unstable_step`)."""
     if method is None and dt_s is None and pwm is None:
         if long_step_refusal(params, controller, t_end_s, program) is None:
             return long_step(params)
-        return EDGE_STEP if edge_step_refusal(params, controller, t_end_s) is None else REFERENCE
-    return Numerics(REFERENCE.method if method is None else method,
-                    REFERENCE.dt_s if dt_s is None else dt_s,
-                    REFERENCE.pwm if pwm is None else pwm)
+        if edge_step_refusal(params, controller, t_end_s) is None:
+            return EDGE_STEP
+    n = Numerics(REFERENCE.method if method is None else method,
+                 reference_dt(params) if dt_s is None else dt_s,
+                 REFERENCE.pwm if pwm is None else pwm)
+    if (why := unstable_step(params, n.method, n.dt_s)) is not None:
+        raise ValueError(why)
+    return n
