@@ -63,6 +63,14 @@ def test_bad_session_settings_name_the_field_and_value(kwargs, match):
         PlantSession("paper2010", **kwargs)
 
 
+def test_a_slider_too_stiff_for_the_plants_step_is_refused_when_made():
+    """A 0.1 m wire pulling 5 g: its wire-slider mode makes the plant's RK4 at 1 ms unstable
+    (engine.numerics.unstable_step). It was accepted and refused at reset() (found by review)."""
+    with pytest.raises(ValueError, match=r"overrides \['wire_length_m=0.1', 'slider_mass_kg=0.005'\]: the plant runs at "
+                                         r"rk4, 0.001 s \(not settable here\): dt_s = 0.001 is beyond rk4's stability"):
+        PlantSession("linear-bias-spring", target=0.005, overrides=("wire_length_m=0.1", "slider_mass_kg=0.005"))
+
+
 def test_numpy_numbers_are_settings_too():
     s = PlantSession("paper2010", control_interval_s=np.float32(0.25), episode_s=np.int64(1), target=np.float64(-30))
     assert s.n_steps == 4 and s.target == -30.0

@@ -237,6 +237,22 @@ def test_sweep_table_and_rerun_is_idempotent(tmp_path):
     pd.testing.assert_frame_equal(_frame(out), first)
 
 
+def test_a_base_set_no_run_could_use_does_not_stop_a_sweep_of_good_points(tmp_path):
+    """Every point stable at the given step, the base set alone not (a 0.1 m wire pulling its
+    20 g at rk4 1 ms: engine.numerics.unstable_step): the sweep ran every point, then failed
+    writing the base's settings into the table's metadata, an internal error with no table
+    (found by review). The base is no run: its settings are recorded, not checked."""
+    spec = tmp_path / "stiff.toml"
+    spec.write_text('[base]\nparams = "linear-bias-spring"\nset = { wire_length_m = 0.1, V_H_V = 1.2 }\n'
+                    'strategy = "open-loop"\nvoltage = "0:0.6,1:0"\nt_end_s = 2.0\ndt_s = 0.001\n'
+                    '[sweep]\nmode = "list"\n[vary]\nslider_mass_kg = [0.5, 0.1]\n')
+    out = tmp_path / "stiff.parquet"
+    rep = run_sweep(spec, out, workers=1)
+    assert (rep.total, rep.ran, rep.failed) == (2, 2, 0)
+    df = pd.read_parquet(out)
+    assert (df["status"] == "ok").all() and (df["run_dt_s"] == 0.001).all()
+
+
 def test_interrupted_sweep_resumes(tmp_path):
     spec = _write(tmp_path, SMALL.replace("[sweep]\n", "[sweep]\nchunk_size = 2\n"))
     out = tmp_path / "res.parquet"

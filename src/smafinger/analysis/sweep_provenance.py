@@ -24,7 +24,7 @@ def run_settings(run_kw: dict, params) -> dict:
     """The base run settings with make_spec's defaults filled in (the numerics as they resolve
     for the base run, :mod:`smafinger.engine.numerics`; a point's varied values can change its
     own, which its row's ``run_method``, ``run_dt_s``, ``run_pwm`` hold), as JSON values."""
-    from ..engine.numerics import choose
+    from ..engine.numerics import chosen
     from ..engine.run import make_spec
     from ..profiles import TargetProfile, VoltageProgram
     from ..provenance import program_text
@@ -34,7 +34,7 @@ def run_settings(run_kw: dict, params) -> dict:
     program = given["voltage"]
     if isinstance(program, str):
         program = VoltageProgram.parse(program, given["drive"])
-    n = choose(params, given["controller"], given["t_end_s"], given["method"], given["dt_s"], given["pwm"], program)
+    n = chosen(params, given["controller"], given["t_end_s"], given["method"], given["dt_s"], given["pwm"], program)
     given.update(method=n.method, dt_s=n.dt_s, pwm=n.pwm)
     out = {}
     for k, v in given.items():

@@ -49,6 +49,11 @@ class PlantSession:
             raise ValueError(f"overrides = {overrides!r} must be a list of NAME=VALUE strings")
         p = get_params(params) if isinstance(params, str) else params
         self.params = p.with_overrides(list(overrides)) if overrides else p
+        from ..engine.numerics import unstable_step
+
+        if (why := unstable_step(self.params, BENCH_NUMERICS["method"], BENCH_NUMERICS["dt_s"])) is not None:
+            raise ValueError(f"params {self.params.name} with overrides {list(overrides)}: the plant runs at "
+                             f"{BENCH_NUMERICS['method']}, {BENCH_NUMERICS['dt_s']:g} s (not settable here): {why}")
         self.dt = _positive("control_interval_s", control_interval_s)
         if self.dt < BENCH_NUMERICS["dt_s"]:
             raise ValueError(f"control_interval_s = {control_interval_s!r} is shorter than the plant's step, "

@@ -58,7 +58,7 @@ def simulate(
     t_end: float = typer.Option(20.0, "--t-end", metavar="S", help="simulated time [s]"),
     dt: Optional[float] = typer.Option(None, "--dt", metavar="S", help="integration step [s] [default: see --method]"),
     method: Optional[Method] = typer.Option(None, "--method", help="integrator (authors-ode4: the authors' Simulink "
-                                                                   f"solver, fixed 1 ms, PWM read at its stages) {NUMERICS_HELP}"),
+                                                                   f"solver, fixed 1 ms (shorter on a stiff slider), PWM read at its stages) {NUMERICS_HELP}"),
     pwm: Optional[Pwm] = typer.Option(None, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
                                                           "averaged power (averaged: long steps) [default: see --method]"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
