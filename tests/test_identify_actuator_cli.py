@@ -117,6 +117,21 @@ def test_a_stiff_slider_is_fitted_at_its_stable_step(tmp_path):
     assert 0 < se < 0.1 and abs(a_s - 71.0) < 3 * se
 
 
+def test_a_freed_slider_mass_is_fitted_at_the_step_of_its_lightest_bound(tmp_path):
+    """With slider_mass_kg free down to 5 g, the template's wire-slider mode reaches 1,810 rad/s,
+    beyond RK4 at 1 ms: those candidates were refused one by one and scored as misses. The fit
+    now runs at the step of the stiffest set its bounds allow (0.5 ms), to the noise."""
+    bs.write_csv(tmp_path / "a.csv", bs.open_loop_run(LINEAR.replace(slider_mass_kg=0.008), "0:0,0.2:0.6,0.6:0,3:0",
+                                                      4.0, noise=2e-5, offset=1e-3, seed=2))
+    r = invoke("--params", "linear-bias-spring", "--fit", tmp_path / "a.csv", "--free", "slider_mass_kg:0.005:0.05",
+               "--budget", "30", "--max-nfev", "10", "--workers", "1", "--report", tmp_path / "r.json")
+    assert r.exit_code == 0, r.output
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["fit"]["settings"]["dt_s"] == 5e-4
+    assert 0.005 <= rep["fit"]["values"]["slider_mass_kg"] <= 0.05
+    assert rep["files"][0]["rms_m"] < 3e-5  # to the noise (2e-5 m): the mass barely shows in the position
+
+
 def test_the_fit_is_the_same_in_this_process_and_in_two_workers(files):
     """The batch engine is deterministic and CMA-ES is seeded: the fit is bit-identical however
     its simulations are spread."""

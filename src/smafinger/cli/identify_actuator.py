@@ -97,7 +97,7 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     from ..analysis.bench_runs import load_closed_loop, load_open_loop
     from ..analysis.data import same_data
     from ..analysis.free_params import FreeBox, parse_free
-    from ..engine.numerics import reference_dt
+    from ..engine.numerics import reference_dt_within
     from ..parameters import REGISTRY, resolve
     from ..recordings import parse_map_options
 
@@ -123,7 +123,9 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     p = resolve(params).with_overrides(overrides)
     parse_map_options(maps)  # refuse a bad --map before reading any file
     controller = _controller(gains, duty_max) if replay else None
-    dt_s = reference_dt(p)  # RK4's step: 1 ms, shorter on a stiff slider (engine.numerics)
+    box = FreeBox(p, parse_free(p, free)) if fit else None
+    # RK4's step: 1 ms, shorter on a stiff slider, for the stiffest set the fit may try (engine.numerics)
+    dt_s = reference_dt_within(p, {name: (f.lo, f.hi) for f in box.free for name in f.fields} if box else {})
     runs = [load_open_loop(*_run_map(a, maps), "fit", p, wire=wire, dt_s=dt_s) for a in fit]
     runs += [load_open_loop(*_run_map(a, maps), "validate", p, wire=wire, dt_s=dt_s) for a in validate]
     runs += [load_closed_loop(*_run_map(a, maps), p, controller, reference=reference, offset=offset == "per-run",
@@ -134,7 +136,6 @@ def _setup(params, overrides, fit, validate, replay, maps, reference, gains, dut
     for run in runs if offset == "per-run" else []:
         if run.role == "validate":  # its offset is measured on its baseline (a fitted run's is fitted)
             run.check_baseline()
-    box = FreeBox(p, parse_free(p, free)) if fit else None
     settings = FitSettings(budget=budget, max_nfev=max_nfev, seed=seed, fit_offsets=offset == "per-run", dt_s=dt_s)
     base = params if (params in REGISTRY and not overrides) else p
     return dict(params=params, overrides=overrides, p=p, base=base, runs=runs, box=box, settings=settings,

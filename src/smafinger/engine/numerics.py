@@ -309,6 +309,18 @@ def reference_dt(params) -> float:
     return DEFAULT_DT_S / n
 
 
+#: the fields the wire-slider mode's omega grows with (+1) or falls with (-1) (:func:`wire_mode_omega`)
+_OMEGA_FIELDS = {"D_A_Pa": 1, "wire_diameter_m": 1, "bias_spring_K_N_m": 1, "wire_length_m": -1, "slider_mass_kg": -1}
+
+
+def reference_dt_within(params, bounds) -> float:
+    """:func:`reference_dt` of the stiffest set within ``bounds`` (field name -> (lo, hi), the
+    others as in ``params``): one step that holds every set a fit may try. A freed slider mass
+    or wire had candidates beyond the start set's step, each refused and scored as a miss."""
+    stiffest = {name: bounds[name][1 if sign > 0 else 0] for name, sign in _OMEGA_FIELDS.items() if name in bounds}
+    return reference_dt(params.replace(**stiffest) if stiffest and params.mechanism != "joint" else params)
+
+
 #: the divisors of 10^6 (1 ms in nanoseconds), ascending
 _DIVISORS_OF_1MS = tuple(sorted(2 ** i * 5 ** j for i in range(7) for j in range(7)))
 
