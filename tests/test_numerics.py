@@ -177,8 +177,8 @@ def test_the_linear_rigs_long_step_holds_the_return_but_not_a_cut_mid_transforma
     the return lagged, 0.126 mm RMS, 0.91 mm max (found by review). But full duty cut at 0.65 s,
     while the wire transforms: the slider coasts on for about 1/omega (the wire-slider mode, 904
     rad/s), the unloaded wire transforms further and the memory rule keeps it; the long step
-    damps that mode: 0.224 mm RMS, 0.831 mm max (found by a random search), so the rig's default
-    is the reference, rk4 at 1 ms: 0.0001 / 0.0032 mm there."""
+    damps that mode: 0.831 mm max, 0.448 mm RMS over these 10 s (found by a random search), so the
+    rig's default is the reference, rk4 at 1 ms: 0.0003 / 0.0032 mm there."""
     kw = dict(LINEAR_PROGRAM, t_end_s=45.0)
     assert _numerics(make_spec("linear-bias-spring", "open-loop", **kw)) == REF
     ref = simulate("linear-bias-spring", "open-loop", **kw, dt_s=1e-4)

@@ -122,8 +122,8 @@ def long_step_refusal(params, controller, t_end_s: float, program=None) -> str |
       max; docs/speed.md): the wire against the slider's mass is a mode of 500-900 rad/s on the
       template, and a drive cut while the wire transforms lets the slider coast on for about
       1/omega, unloading the wire, which transforms further, and the memory rule keeps it. The
-      long step damps that mode (the template, full duty cut at 0.65 s: 0.22 mm RMS, 0.83 mm
-      max; semi-implicit at 0.1 ms still 0.16 mm max; rk4 at 1 ms 0.003 mm). Fast cooling
+      long step damps that mode (the template, full duty cut at 0.65 s: 0.83 mm max, 0.22 mm
+      RMS over 40 s; semi-implicit at 0.1 ms still 0.16 mm max; rk4 at 1 ms 0.003 mm). Fast cooling
       (h0_cooling 600 W/m^2K: 0.73 mm max), static friction of 0.8 N (0.77 mm max) and a start
       off the major loop fail too. Through the wire's return to martensite its long step holds
       since 0a71aa2 (its program run to 45 s: 0.008 mm RMS, 0.047 mm max; it was 0.13, 0.91).
