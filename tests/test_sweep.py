@@ -93,6 +93,22 @@ def test_the_pwm_model_is_a_run_setting_with_its_own_run_id():
                     "vary": {"tol_deg": {"values": [0.5]}}}).runs()
 
 
+def test_a_rigs_duty_program_and_tolerance_are_run_settings_with_their_own_run_ids():
+    """A linear rig's sweep may give its program as a duty (``drive``) and set or vary its
+    tolerance in metres (``tol_m``): both were refused, while a tol_deg on the rig was refused
+    with 'give tol_m' (found by review). Their defaults leave the canonical spec, and so the run
+    ids of earlier sweeps, as they were."""
+    base = {"params": "linear-bias-spring", "strategy": "open-loop", "voltage": "0:0.6,3:0", "t_end_s": 1.0}
+    duty, volts = parse_spec({"base": {**base, "drive": "duty"}, "vary": {"tol_m": {"values": [5e-4]}}}).runs()[0], \
+        parse_spec({"base": base, "vary": {"tol_m": {"values": [5e-4]}}}).runs()[0]
+    assert duty.spec.voltage.kind == "duty" and canonical_run(duty.spec)["drive"] == "duty"
+    assert "drive" not in canonical_run(volts.spec) and duty.run_id != volts.run_id
+    closed = parse_spec({"base": {"params": "linear-bias-spring", "profile": "0:0.01", "t_end_s": 1.0},
+                         "vary": {"tol_m": {"values": [1e-4, 5e-4]}}}).runs()
+    assert [r.spec.tol_m for r in closed] == [1e-4, 5e-4] and closed[0].run_id != closed[1].run_id
+    assert canonical_run(closed[0].spec)["tol_m"] == 1e-4 and "tol_m" not in canonical_run(closed[1].spec)
+
+
 def test_each_row_records_the_numerics_its_run_used(tmp_path):
     """A point's varied values can change its default numerics (engine.numerics): the rows say
     which each run used, and an explicit dt_s gives rk4 with exact PWM (the reference's others)."""

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ..engine.defaults import DEFAULT_PWM
+from ..engine.defaults import DEFAULT_PWM, DEFAULT_TOL_M
 from ..engine.run import RunSpec, make_spec
 from ..parameters import ParameterError, ParameterSet, resolve
 from ..profiles import ProfileError
@@ -32,7 +32,7 @@ MODES = ("grid", "list", "random", "lhs")
 RUN_KEYS = {
     "params": str, "strategy": str, "profile": str, "voltage": str, "t_end_s": float,
     "dt_s": float, "method": str, "output_interval_s": float, "tol_deg": float,
-    "hold_s": float, "independent_wait": bool, "pwm": str,
+    "hold_s": float, "independent_wait": bool, "pwm": str, "drive": str, "tol_m": float,
 }
 #: sweeps with more runs are refused before anything is made (``--max-runs`` raises it)
 DEFAULT_MAX_RUNS = 1_000_000
@@ -80,8 +80,11 @@ def canonical_run(spec: RunSpec) -> dict:
         "t_end_s": spec.t_end_s, "dt_s": spec.dt_s, "method": spec.method,
         "output_interval_s": spec.output_interval_s, "tol_deg": spec.tol_deg,
         "hold_s": spec.hold_s, "independent_wait": spec.independent_wait,
-        # the PWM model only when it is not the default: the run ids of earlier sweeps stay valid
+        # the PWM model, the drive's kind and the linear tolerance only when they are not the
+        # defaults: the run ids of earlier sweeps stay valid
         **({} if spec.pwm == DEFAULT_PWM else {"pwm": spec.pwm}),
+        **({} if v is None or v.kind == "voltage" else {"drive": v.kind}),
+        **({} if spec.tol_m == DEFAULT_TOL_M else {"tol_m": spec.tol_m}),
     }
 
 
