@@ -225,6 +225,9 @@ def test_an_explicit_step_beyond_the_wire_slider_modes_stability_is_refused(meth
     with pytest.raises(ValueError, match=rf"dt_s = {dt_s:g} is beyond {method}'s stability limit .* use dt_s <= "):
         make_spec(p, "open-loop", voltage="0:0.1", drive="duty", t_end_s=1.0, method=method, dt_s=dt_s)
     assert make_spec(p, "open-loop", voltage="0:0.1", drive="duty", t_end_s=1.0, method="semi-implicit", dt_s=dt_s)
+    if method in ("euler", "exponential"):  # no dt_s given: the refusal says whose step it is
+        with pytest.raises(ValueError, match=r"\(dt_s not given: the reference's step on this slider\)"):
+            make_spec(p, "open-loop", voltage="0:0.1", drive="duty", t_end_s=1.0, method=method)
 
 
 def test_the_algebraic_laws_long_step_on_the_authors_joint():

@@ -367,5 +367,5 @@ def choose(params, controller, t_end_s: float, method: str | None, dt_s: float |
     wire-slider mode makes unstable (:func:`unstable_step`)."""
     n = chosen(params, controller, t_end_s, method, dt_s, pwm, program)
     if (why := unstable_step(params, n.method, n.dt_s)) is not None:
-        raise ValueError(why)
+        raise ValueError(why if dt_s is not None else f"{why} (dt_s not given: the reference's step on this slider)")
     return n
