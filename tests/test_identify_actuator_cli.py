@@ -14,6 +14,7 @@ from smafinger.analysis.free_params import FreeBox, parse_free
 from smafinger.cli.identify_actuator import actuator
 from smafinger.engine.batch import make_pool
 from smafinger.parameters import get
+from smafinger.parameters.files import to_toml
 
 LINEAR = get("linear-bias-spring")
 JOINT = get("paper2010")
@@ -130,6 +131,28 @@ def test_a_freed_slider_mass_is_fitted_at_the_step_of_its_lightest_bound(tmp_pat
     assert rep["fit"]["settings"]["dt_s"] == 5e-4
     assert 0.005 <= rep["fit"]["values"]["slider_mass_kg"] <= 0.05
     assert rep["files"][0]["rms_m"] < 3e-5  # to the noise (2e-5 m): the mass barely shows in the position
+
+
+def test_a_value_the_runs_leave_anywhere_within_its_bounds_is_not_determined(tmp_path):
+    """A 3 g slider on a 0.15 m, 0.25 mm wire: the position barely depends on the mass, so every
+    mass from 1.25 to 20 g fits the runs within a noise variance. The linearised error said
+    18.2 +- 6.5 g, the truth 2.3 errors off (found by review). The runs simulated with the mass
+    at each bound now mark it not determined."""
+    rig = LINEAR.replace(wire_diameter_m=2.5e-4, wire_length_m=0.15, resistance_ohm_per_m=16.0, V_H_V=4.0,
+                         slider_mass_kg=0.003, bias_spring_K_N_m=200.0, bias_spring_preload_N=2.4, A_S0_C=72.0,
+                         A_F0_C=83.0, M_S0_C=55.0, M_F0_C=44.0, h0_heating_W_m2K=55.0, h0_cooling_W_m2K=35.0, eps_R=0.02)
+    runs = (("step", "0:0,0.5:0.10,5:0", 10.0, 0.3e-3), ("square", "0:0,0.5:0.2,1.5:0,3.5:0.2,4.5:0,6.5:0.2,7:0", 10.0,
+            -0.2e-3), ("stairs", "0:0,0.5:0.05,3.5:0.065,6.5:0.08,9.5:0", 13.0, 0.5e-3))
+    for seed, (name, prog, t_end, offset) in enumerate(runs, start=1):
+        bs.write_csv(tmp_path / f"{name}.csv", bs.open_loop_run(rig, prog, t_end, noise=1e-5, offset=offset, seed=seed))
+    (tmp_path / "rig.toml").write_text(to_toml(rig.replace(slider_mass_kg=0.005)))
+    r = invoke("--params", tmp_path / "rig.toml", "--free", "slider_mass_kg", *[a for name, *_ in runs for a in
+               ("--fit", tmp_path / f"{name}.csv")], "--budget", "20", "--max-nfev", "10", "--workers", "1",
+               "--report", tmp_path / "r.json")
+    assert r.exit_code == 0, r.output
+    fit = json.loads((tmp_path / "r.json").read_text())["fit"]
+    assert fit["stderr"]["slider_mass_kg"] is None and fit["rank_deficient"]
+    assert "not determined by these runs: slider_mass_kg" in r.output and "at both bounds" in r.output
 
 
 def test_the_fit_is_the_same_in_this_process_and_in_two_workers(files):

@@ -322,3 +322,18 @@ def test_a_standard_error_wider_than_the_bounds_is_not_determined():
     assert mark_undetermined(cov, [np.inf, 1e12, se / (UNDETERMINED_WIDTHS * 0.99)]) is cov
     assert mark_undetermined(cov, [np.inf, 1e12, se / (UNDETERMINED_WIDTHS * 1.01)]).undetermined.tolist() == [
         False, False, True]
+
+
+def test_a_value_is_flat_within_its_bounds_only_if_both_stay_within_a_noise_variance():
+    """flat_within_bounds: the misfit at each bound against the solution's, in noise variances
+    (SSE / dof), widened by the residuals' correlation (stderr / stderr_white)^2."""
+    from smafinger.analysis.fit_uncertainty import Covariance, flat_within_bounds
+
+    sse, dof = 100.0, 100  # noise variance 1
+    cov = Covariance(ar1=np.diag([1.0, 1.0, 4.0, np.inf]), white=np.diag([1.0, 1.0, 1.0, 1.0]), rho=np.zeros(1),
+                     sigma=np.ones(1), dof=dof, rank_deficient=False)
+    at_bounds = sse + np.array([[0.5, 0.9],    # both within 1: flat
+                                [0.5, 1.5],    # one bound beyond: determined
+                                [3.0, 3.5],    # 3.5 variances, but widened 4x by the correlation: flat
+                                [0.0, 0.0]])   # already not determined: left to the other rule
+    assert flat_within_bounds(at_bounds, sse, cov).tolist() == [True, False, True, False]

@@ -35,7 +35,8 @@ from ..engine.defaults import DEFAULT_DT_S, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 from ..parameters import ParameterSet
 from .actuator_eval import Evaluator
 from .bench_runs import BenchRun
-from .fit_uncertainty import UNDETERMINED_WIDTHS, Covariance, covariance, mark_undetermined
+from .fit_uncertainty import (DETERMINED_CHI2, UNDETERMINED_WIDTHS, Covariance, covariance, flat_within_bounds,
+                               mark_undetermined, marked)
 from .free_params import FreeBox, FreeParameter
 
 UNCERTAINTY_METHOD = (
@@ -224,8 +225,10 @@ def local_stage(ev: Evaluator, u0: np.ndarray, s: FitSettings) -> tuple[np.ndarr
 
 def uncertainty(ev: Evaluator, u: np.ndarray, s: FitSettings) -> tuple[Covariance, np.ndarray]:
     """Covariance of (fitted values, offsets) at u, and the offsets there; a value whose standard
-    error exceeds UNDETERMINED_WIDTHS times the width of its bounds is marked not determined
-    (infinite)."""
+    error exceeds UNDETERMINED_WIDTHS times the width of its bounds, or whose bounds both leave
+    the misfit within DETERMINED_CHI2 noise variances of the solution's (the runs simulated
+    with it at each bound: 2 points a value, :func:`.fit_uncertainty.flat_within_bounds`), is
+    marked not determined (infinite)."""
     Jm, centre = ev.model_jacobian(u, s.diff_step)
     n = ev.box.n
     blocks = [Jm]
@@ -247,7 +250,10 @@ def uncertainty(ev: Evaluator, u: np.ndarray, s: FitSettings) -> tuple[Covarianc
 
     cov = Covariance(to_values(cov.ar1), to_values(cov.white), cov.rho, cov.sigma, cov.dof, cov.rank_deficient)
     widths = [f.hi - f.lo for f in ev.box.free] + [np.inf] * (cov.ar1.shape[0] - n)  # offsets: unbounded
-    return mark_undetermined(cov, widths), centre.offsets
+    cov = mark_undetermined(cov, widths)
+    ends = [np.where(np.arange(n) == i, end, u) for i in range(n) for end in (0.0, 1.0)]  # the unit box's bounds
+    flat = flat_within_bounds(ev.sse(ends).reshape(n, 2), centre.sse, cov)
+    return marked(cov, np.concatenate([flat, np.zeros(cov.ar1.shape[0] - n, dtype=bool)])), centre.offsets
 
 
 def fit_actuator(runs: Sequence[BenchRun], box: FreeBox, pool, settings: FitSettings = FitSettings(),
@@ -280,8 +286,9 @@ def fit_actuator(runs: Sequence[BenchRun], box: FreeBox, pool, settings: FitSett
     if cov.rank_deficient:
         labels = list(names) + ([f"the offset of {f}" for f in files] if settings.fit_offsets else [])
         lost = [k for k, bad in zip(labels, cov.undetermined) if bad]
-        notes.append(f"not determined by these runs: {', '.join(lost)} (a singular Jacobian, or a standard error "
-                     f"more than {UNDETERMINED_WIDTHS:g} times the width of the bounds): standard error infinite "
+        notes.append(f"not determined by these runs: {', '.join(lost)} (a singular Jacobian, a standard error "
+                     f"more than {UNDETERMINED_WIDTHS:g} times the width of the bounds, or a misfit within "
+                     f"{DETERMINED_CHI2:g} noise variance of the solution's at both bounds): standard error infinite "
                      "(null in the report)")
     if start_eval.failures:
         notes.append(f"the start set failed on a run ({start_eval.failures[0]})")

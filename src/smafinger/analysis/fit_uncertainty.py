@@ -168,10 +168,48 @@ def mark_undetermined(cov: Covariance, widths: np.ndarray) -> Covariance:
         offset).
     """
     widths = np.asarray(widths, dtype=np.float64)
-    wide = ~(cov.stderr <= UNDETERMINED_WIDTHS * widths)  # an infinite variance stays marked
-    if not wide.any():
+    return marked(cov, ~(cov.stderr <= UNDETERMINED_WIDTHS * widths))  # an infinite variance stays marked
+
+
+def marked(cov: Covariance, which: np.ndarray) -> Covariance:
+    """``cov`` with the quantities flagged in ``which`` (bool each) not determined: their
+    variances infinite (both) and ``rank_deficient`` set."""
+    which = np.asarray(which, dtype=bool)
+    if not which.any():
         return cov
     ar1, white = cov.ar1.copy(), cov.white.copy()
     for c in (ar1, white):
-        c[wide, wide] = np.inf
+        c[which, which] = np.inf
     return Covariance(ar1, white, cov.rho, cov.sigma, cov.dof, True)
+
+
+#: a fitted value counts as determined within its bounds only if moving it to one of them, the
+#: others held, raises the misfit by this many noise variances or more (chi^2 allowing for the
+#: residuals' correlation: :func:`flat_within_bounds`)
+DETERMINED_CHI2 = 1.0
+
+
+def flat_within_bounds(sse_at_bounds: np.ndarray, sse: float, cov: Covariance) -> np.ndarray:
+    """Which fitted values the data leave anywhere within their bounds (bool each): the misfit
+    at each bound, the others held at the solution, is less than :data:`DETERMINED_CHI2` noise
+    variances above the solution's. The linearised standard error can be finite and small there:
+    a slider's mass that changes the runs' sum of squares by 0.44 noise variances between 5 and
+    18 g was reported as 18 +- 6.5 g, the truth 3 g (found by review). Held, the others cannot
+    make the profile flatter than this, only steeper, so this flags no value the data determine.
+
+    Parameters
+    ----------
+    sse_at_bounds : ndarray, shape (n, 2)
+        The sum of squared residuals with value i at its lower and its upper bound.
+    sse : float
+        At the solution.
+    cov : Covariance
+        At the solution; its first n quantities are the values (the noise variance is the
+        residuals' mean square over ``dof``; the correlation of the residuals widens it by
+        (stderr / stderr_white)^2 for each value).
+    """
+    n = sse_at_bounds.shape[0]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        widening = (cov.stderr[:n] / cov.stderr_white[:n]) ** 2
+        chi2 = (np.asarray(sse_at_bounds) - sse) / (sse / cov.dof) / np.maximum(widening, 1.0)[:, None]
+    return np.isfinite(widening) & (np.nan_to_num(chi2, nan=np.inf) < DETERMINED_CHI2).all(axis=1)
