@@ -61,6 +61,18 @@ def test_an_edited_definition_is_refused():
             spec_from_definition(broken)
 
 
+def test_a_recorded_run_whose_step_was_unstable_is_refused_saying_its_results_are_wrong():
+    """A stiff slider's run recorded at rk4 1 ms (before such steps were refused: it went unstable,
+    held by the end stops, and its results are wrong): --from refuses it, and its advice is one
+    --from can follow (the step's own advice, --dt, is refused with --from; found by review)."""
+    p = get("linear-bias-spring").replace(wire_length_m=0.1, slider_mass_kg=0.005)
+    definition = run_definition(make_spec(p, "open-loop", voltage="0:0.1", drive="duty", t_end_s=1.0))
+    assert definition["dt_s"] == 1.25e-4
+    with pytest.raises(ProvenanceError, match=r"run: dt_s = 0.001 is beyond rk4's stability limit .*, so the recorded "
+                                              r"run went unstable and its results are wrong .* without --from"):
+        spec_from_definition({**definition, "dt_s": 1e-3}, "--from old.json: run")
+
+
 # ---- the outputs carry it ------------------------------------------------------------------------
 def test_every_signal_format_and_the_summary_carry_the_provenance(tmp_path):
     r = simulate("paper2010", "cooperative", "0:-25", t_end_s=1.0, output_interval_s=0.01)

@@ -100,6 +100,12 @@ def spec_from_definition(definition: Any, where: str = "run definition"):
         for k in ("dt_s", "method", "pwm"):  # null would mean "the default", which may change
             if run[k] is None:
                 raise ProvenanceError(f"{where}: {k} = null: a run definition names its numerics")
+        from .engine.numerics import unstable_step
+
+        if (why := unstable_step(p, run["method"], run["dt_s"], advice=False)) is not None:
+            raise ProvenanceError(f"{where}: {why}, so the recorded run went unstable and its results are wrong "
+                                  "(made before such steps were refused): simulate its parameters again, without "
+                                  "--from, at the default step")
         return make_spec(p, voltage=None if drive is None else drive["program"],
                          drive="voltage" if drive is None else drive["kind"],
                          controller=_controller(definition.get("controller")), **run)

@@ -325,7 +325,7 @@ def reference_dt_within(params, bounds) -> float:
 _DIVISORS_OF_1MS = tuple(sorted(2 ** i * 5 ** j for i in range(7) for j in range(7)))
 
 
-def unstable_step(params, method: str, dt_s: float) -> str | None:
+def unstable_step(params, method: str, dt_s: float, advice: bool = True) -> str | None:
     """Why a method's step cannot hold the run's wire-slider mode (None: it can, or the
     mechanism has none): RK4 and the authors' solver beyond h omega = 2 sqrt(2); Euler and
     exponential Euler (exact in the damping, explicit in the wire's stiffness) beyond
@@ -342,9 +342,9 @@ def unstable_step(params, method: str, dt_s: float) -> str | None:
         limit = params.viscous_damping_N_s_m / params.slider_mass_kg / omega ** 2
     else:
         return None
-    return (f"dt_s = {dt_s:g} is beyond {method}'s stability limit for this slider's wire-slider mode "
-            f"(omega = {omega:.4g} rad/s, the wire in austenite against the slider's mass): use dt_s <= {limit:.3g} "
-            f"or method semi-implicit")
+    why = (f"dt_s = {dt_s:g} is beyond {method}'s stability limit for this slider's wire-slider mode "
+           f"(omega = {omega:.4g} rad/s, the wire in austenite against the slider's mass)")
+    return f"{why}: use dt_s <= {limit:.3g} or method semi-implicit" if advice else why
 
 
 def chosen(params, controller, t_end_s: float, method: str | None, dt_s: float | None,
