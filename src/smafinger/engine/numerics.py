@@ -17,7 +17,9 @@ validated for it against a run at a far shorter step with exact PWM edges:
   resolved at its edges, so a sub-step ends at every edge and output sample, as with the
   reference, but costs one right-hand side instead of four;
 - the reference settings (RK4, 1 ms, exact PWM) everywhere else; on a slider, RK4's step is
-  shortened to hold the wire-slider mode (:func:`reference_dt`).
+  shortened to hold the wire-slider mode (:func:`reference_dt`). The reference itself is not
+  validated on every rig: on a light, lightly damped slider it can be over the budget
+  (docs/speed.md, "The linear rig").
 
 A run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where each holds and why it does not elsewhere: docs/speed.md.
