@@ -196,9 +196,6 @@ def extreme_parameters(params) -> list[str]:
     return [text for factor, text in sorted(found, key=lambda x: -x[0]) if math.isfinite(factor)]
 
 
-#: |lambda dt| up to which each explicit integrator is stable on a real, negative mode (the
-#: damping's): Euler 2, classical RK4 2.785 (its stability region on the negative real axis)
-EXPLICIT_STABILITY = {"euler": 2.0, "rk4": 2.785, "authors-ode4": 2.785}
 
 
 def damping_rate_per_s(params) -> float:
@@ -211,7 +208,9 @@ def damping_rate_per_s(params) -> float:
 
 def blowup_hint(spec) -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
-    limit = EXPLICIT_STABILITY.get(spec.method)
+    from .engine.stability import REAL_AXIS
+
+    limit = REAL_AXIS.get(spec.method)
     rate = damping_rate_per_s(spec.params)
     if limit is not None and rate * spec.dt_s > limit:
         hint = (f"{spec.method} is stable only up to dt = {limit / rate * 1e3:.2g} ms against this set's damping "

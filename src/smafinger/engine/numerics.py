@@ -37,6 +37,7 @@ import numpy as np
 from ..parameters.options import Hysteresis, JouleHeating, StressLaw
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
                        LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
+from .stability import UNDAMPED
 
 #: the long step needs at least this many steps across the transformation band (A_S0 to A_F0)
 #: at the run's strongest drive (:func:`_fast_transformation`). Measured on the linear rig in
@@ -280,9 +281,6 @@ def edge_step_refusal(params, controller, t_end_s: float) -> str | None:
 #: (:func:`reference_dt`): the template rig in austenite is 0.90 at 1 ms, where a drive cut
 #: while the wire transforms is within 0.003 mm of rk4 at 0.1 ms
 WIRE_MODE_RAD_PER_STEP = 1.0
-#: RK4's stability bound on an undamped mode, h omega <= 2 sqrt(2) (the authors' solver is RK4;
-#: on a damping's real, negative mode the bounds are plausibility.EXPLICIT_STABILITY's)
-RK4_STABLE_H_OMEGA = 2.0 * 2.0 ** 0.5
 
 
 def wire_mode_omega(params) -> float | None:
@@ -329,20 +327,20 @@ _DIVISORS_OF_1MS = tuple(sorted(2 ** i * 5 ** j for i in range(7) for j in range
 
 def unstable_step(params, method: str, dt_s: float, advice: bool = True) -> str | None:
     """Why a method's step cannot hold the run's wire-slider mode (None: it can, or the
-    mechanism has none): RK4 and the authors' solver beyond h omega = 2 sqrt(2); Euler and
-    exponential Euler (exact in the damping, explicit in the wire's stiffness) beyond
-    h omega^2 = c, the viscous damping over the mass (they amplify a mode damped less than that
-    at every step: exponential Euler on the template at 0.1 ms was 1.15 mm RMS, 2.3 mm max off
-    with no warning). Such a run does not blow up: the end stops hold the slider, and the
-    result is wrong (found by review). ``semi-implicit`` takes the stiffness implicitly: any step."""
+    mechanism has none), by :data:`.stability.UNDAMPED`: RK4 and the authors' solver beyond
+    h omega = 2 sqrt(2); Euler and exponential Euler (exact in the damping, explicit in the
+    wire's stiffness) beyond h omega^2 = c, the viscous damping over the mass (they amplify a
+    mode damped less than that at every step: exponential Euler on the template at 0.1 ms was
+    1.15 mm RMS, 2.3 mm max off with no warning). Such a run does not blow up: the end stops hold
+    the slider, and the result is wrong (found by review). ``semi-implicit`` takes the stiffness
+    implicitly: any step."""
     omega = wire_mode_omega(params)
-    if omega is None:
+    bound = UNDAMPED.get(method)
+    if omega is None or bound is None:
         return None
-    if method in ("rk4", "authors-ode4") and dt_s * omega > RK4_STABLE_H_OMEGA:
-        limit = RK4_STABLE_H_OMEGA / omega
-    elif method in ("euler", "exponential") and dt_s * omega ** 2 > params.viscous_damping_N_s_m / params.slider_mass_kg:
-        limit = params.viscous_damping_N_s_m / params.slider_mass_kg / omega ** 2
-    else:
+    c = params.viscous_damping_N_s_m / params.slider_mass_kg
+    limit = bound / omega if bound > 0.0 else c / omega ** 2
+    if dt_s <= limit:
         return None
     why = (f"dt_s = {dt_s:g} is beyond {method}'s stability limit for this slider's wire-slider mode "
            f"(omega = {omega:.4g} rad/s, the wire in austenite against the slider's mass)")
