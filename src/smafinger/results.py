@@ -55,6 +55,8 @@ class SimulationResult:
     recorded: tuple[str, ...] | None = None
     #: every how many of the run's output samples this result keeps (:meth:`decimated`)
     samples_every: int = 1
+    #: the run against the same run at half its step (:mod:`smafinger.step_check`; None: not checked)
+    step_check: Any = None
     _metrics: dict | None = field(default=None, repr=False)
 
     # ---- signals ---------------------------------------------------------------------
@@ -173,6 +175,8 @@ class SimulationResult:
         m["steps"] = self.substeps
         m["wall_s"] = self.wall_s
         m["engine"] = self.engine
+        if self.step_check is not None:
+            m["step_check"] = self.step_check.to_dict()
         return m
 
     def write_summary(self, path: str | Path) -> None:
@@ -237,7 +241,13 @@ def compute_metrics(result: SimulationResult) -> dict:
             "energy_J": m["energy_J"], "electrical_energy_J": m["energy_J"], "heat_J": m["heat_J"],
             "peak_temperature_C": m["peak_temperature_C"],
             "peak_stress_Pa": m["peak_stress_Pa"], "interlock_violations": result.interlock_violations,
-            "warnings": skipped_targets(spans, unit) + check(result)}
+            "warnings": skipped_targets(spans, unit) + check(result) + _step_warning(result)}
+
+
+def _step_warning(result: SimulationResult) -> list[str]:
+    """The step check's warning, if the run was checked and is over the budget (:mod:`.step_check`)."""
+    w = None if result.step_check is None else result.step_check.warning()
+    return [] if w is None else [w]
 
 
 def skipped_targets(spans: list, unit: str) -> list[str]:

@@ -33,6 +33,8 @@ def print_run(result) -> None:
         + " | peak T [°C] " + " ".join(f"{w} {pt[w]:.1f}" for w in wires)
         + " | peak stress [MPa] " + " ".join(f"{w} {ps[w] / 1e6:.2f}" for w in wires)
         + f" | interlock violations {m['interlock_violations']}", highlight=False)
+    if result.step_check is not None:
+        console.print(result.step_check.describe(), highlight=False)
     sys.stdout.flush()
     for w in m["warnings"]:
         print(f"smafinger: warning: {w}", file=sys.stderr)

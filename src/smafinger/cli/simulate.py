@@ -70,6 +70,12 @@ def simulate(
                                        help="signals to FILE.csv (+ FILE.provenance.json), .parquet or .mat"),
     summary: Optional[Path] = typer.Option(None, "--summary", metavar="FILE.json", help="metrics and provenance"),
     plot: Optional[Path] = typer.Option(None, "--plot", metavar="FILE", help="figure to FILE.png, .pdf or .svg"),
+    check_step: Optional[bool] = typer.Option(
+        None, "--check-step/--no-check-step",
+        help="run it again at half the step and compare the position: warn if the error estimated from the "
+             "difference (twice it) is over the accuracy budget the defaults were validated against (docs/cli.md) "
+             "[default: on for the linear rig, whose reference step is not validated on every rig; off for the "
+             "finger joint]"),
     progress: Optional[bool] = progress_option(),
     engine: Optional[Engine] = typer.Option(
         None, "--engine", help="compiled: the numba kernel (compiled first if not cached); interpreted: the same "
@@ -82,6 +88,7 @@ def simulate(
     from ..export import add_plot, add_signals, add_summary
     from ..files import Outputs
     from ..plausibility import blowup_hint
+    from ..step_check import checked_by_default, with_step_check
 
     _check_outputs(out, summary, plot)
     try:
@@ -93,6 +100,8 @@ def simulate(
     with progress_display(progress) as display:
         try:
             result = run_spec(spec, progress=display, engine=setting)
+            if checked_by_default(spec.params) if check_step is None else check_step:
+                result = with_step_check(result, setting, progress=display)
         except DutyNotANumber:  # the step is not what to change
             raise
         except SimulationError as exc:

@@ -19,7 +19,8 @@ validated for it against a run at a far shorter step with exact PWM edges:
 - the reference settings (RK4, 1 ms, exact PWM) everywhere else; on a slider, RK4's step is
   shortened to hold the wire-slider mode (:func:`reference_dt`). The reference itself is not
   validated on every rig: on a light, lightly damped slider it can be over the budget
-  (docs/speed.md, "The linear rig").
+  (docs/speed.md, "The linear rig"), which ``smafinger simulate`` checks after the run by
+  default there (:mod:`smafinger.step_check`).
 
 A run that sets any of the three gets the reference values for the others, as before the
 long-step default existed. Where each holds and why it does not elsewhere: docs/speed.md.

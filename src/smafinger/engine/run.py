@@ -336,7 +336,7 @@ def _run_with_progress(call, mech, t_end_s, progress):
 def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=None, t_end_s=20.0,
              dt_s=None, method=None, output_interval_s=DEFAULT_OUTPUT_S, tol_deg=DEFAULT_TOL_DEG,
              hold_s=0.5, independent_wait=True, progress=False, tol_m=DEFAULT_TOL_M, drive="voltage",
-             pwm=None, controller=None, engine=None):
+             pwm=None, controller=None, engine=None, check_step=False):
     """Simulate an SMA wire actuator (the paper's finger joint or the linear bias-spring rig).
 
     Parameters
@@ -380,6 +380,10 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         while the kernel compiles in the background (:mod:`.interpreted`).
     progress : bool or smafinger.progress.Display
         Show the simulated time as the run goes (a terminal's progress bar).
+    check_step : bool
+        Run it again at half the step and compare (:mod:`smafinger.step_check`): the result's
+        ``step_check``, and a warning among its metrics' if the error estimated from the
+        difference is over the budget. ``smafinger simulate`` does this by default on a slider.
 
     Returns
     -------
@@ -395,4 +399,10 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
                      tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
-    return run_spec(spec, progress=progress, engine=interpreted.engine_setting(engine))
+    setting = interpreted.engine_setting(engine)
+    result = run_spec(spec, progress=progress, engine=setting)
+    if check_step:
+        from ..step_check import with_step_check
+
+        result = with_step_check(result, setting)
+    return result

@@ -28,6 +28,10 @@ class Coordinate(NamedTuple):
     scale: float  #: user value = scale * SI value
     velocity: str  #: exported name of dq/dt (omega_deg_s, velocity_m_s)
     limit: float  #: |target| allowed, in the user unit
+    #: issue 11's accuracy budget for q against a converged run, RMS and largest difference, in the
+    #: user unit (the settings were validated against it: docs/speed.md; :mod:`smafinger.step_check`)
+    accuracy_rms: float
+    accuracy_max: float
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -36,7 +40,7 @@ class JointParameters(ParameterSet):
 
     mechanism: ClassVar[str] = "joint"
     wire_names: ClassVar[tuple[str, ...]] = ("upper", "lower")
-    coordinate: ClassVar[Coordinate] = Coordinate("theta", "deg", 180.0 / math.pi, "omega_deg_s", 89.0)
+    coordinate: ClassVar[Coordinate] = Coordinate("theta", "deg", 180.0 / math.pi, "omega_deg_s", 89.0, 0.05, 0.3)
 
     # --- joint (Eqs. 1-2) -----------------------------------------------------------------
     inertia_kg_m2: float = _num(1e-9, 1.0, "phalanx moment of inertia I")
@@ -136,7 +140,7 @@ class LinearActuatorParameters(ParameterSet):
 
     mechanism: ClassVar[str] = "linear-bias-spring"
     wire_names: ClassVar[tuple[str, ...]] = ("wire",)
-    coordinate: ClassVar[Coordinate] = Coordinate("position", "m", 1.0, "velocity_m_s", 1.0)
+    coordinate: ClassVar[Coordinate] = Coordinate("position", "m", 1.0, "velocity_m_s", 1.0, 0.05e-3, 0.6e-3)
 
     slider_mass_kg: float = _num(1e-6, 100.0, "mass of the slider (and what moves with it)")
     viscous_damping_N_s_m: float = _num(0.0, 1e5, "viscous friction coefficient of the slider")

@@ -1,0 +1,157 @@
+"""A run's step checked after it ran: the same run again at half the step.
+
+The numerics a run gets by default were validated against runs at far shorter steps
+(:mod:`.engine.numerics`, docs/speed.md), but not on every parameter set: on a light, lightly
+damped slider RK4 at its reference step can be over the accuracy budget, most often with no
+plausibility warning (docs/speed.md, "The linear rig"). :func:`check_step` runs the same spec
+at half the step (the same integrator and PWM model) and compares the mechanism's coordinate
+sample by sample.
+
+For an error of order p in the step, a run's own error is about ``r**p / (r**p - 1)`` times its
+difference from the run at the step divided by r (Richardson's estimate; r = 2 here). The check
+takes p = 1 (:data:`ASSUMED_ORDER`): the order of the errors the step's decisions make (stick or
+slip, branch, reach; docs/speed.md) and of the first-order integrators, so it estimates twice the
+difference, an overestimate where the error is of higher order. A run whose estimate is over its
+coordinate's accuracy budget (:attr:`.parameters.mechanisms.Coordinate.accuracy_rms`,
+``accuracy_max``) is flagged.
+
+What it cannot see: an error that does not shrink from the step to its half (a random search of
+the linear rig: 4 of 67 open-loop runs over the budget were not flagged, docs/speed.md), and the
+error of a model choice the step leaves as it is (the averaged PWM against the exact edges).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+#: the order in the step assumed of a run's error (the module docstring)
+ASSUMED_ORDER = 1
+
+
+@dataclass(frozen=True)
+class StepCheck:
+    """A run against the same run at a shorter step: the coordinate's difference, user unit."""
+
+    signal: str  #: the coordinate's exported name (``theta_deg``, ``position_m``)
+    dt_s: float  #: the run's step [s]
+    check_dt_s: float  #: the shorter step it was run at again [s]
+    rms: float  #: RMS of the difference over the run's samples
+    max: float  #: the largest difference
+    at_s: float  #: when the largest difference occurred [s]
+    budget_rms: float  #: the coordinate's accuracy budget, RMS
+    budget_max: float  #: and largest
+
+    @property
+    def factor(self) -> float:
+        """The run's error over the difference (Richardson's, for an error of :data:`ASSUMED_ORDER`)."""
+        r = (self.dt_s / self.check_dt_s) ** ASSUMED_ORDER
+        return r / (r - 1.0)
+
+    @property
+    def estimated_rms(self) -> float:
+        return self.factor * self.rms
+
+    @property
+    def estimated_max(self) -> float:
+        return self.factor * self.max
+
+    @property
+    def within(self) -> bool:
+        """Whether the estimated error is within the budget (both RMS and largest)."""
+        return self.estimated_rms <= self.budget_rms and self.estimated_max <= self.budget_max
+
+    @property
+    def unit(self) -> str:
+        return self.signal.rsplit("_", 1)[1]
+
+    def describe(self) -> str:
+        """One line: the difference, the estimate and the budget."""
+        u = self.unit
+        return (f"step check: {self.signal} against the same run at dt_s = {self.check_dt_s:g}: difference RMS "
+                f"{self.rms:.3g} {u}, max {self.max:.3g} {u} (t = {self.at_s:.4g} s); the error at "
+                f"dt_s = {self.dt_s:g}, estimated at {self.factor:g}x that, is "
+                f"{'within' if self.within else 'over'} the budget ({self.budget_rms:g} {u} RMS, "
+                f"{self.budget_max:g} {u} max)")
+
+    def warning(self) -> str | None:
+        """The warning of a run whose estimated error is over the budget (None if within)."""
+        if self.within:
+            return None
+        return (f"the run has not converged at its step: against the same run at half the step its {self.signal} "
+                f"differs by {self.rms:.3g} {self.unit} RMS, {self.max:.3g} {self.unit} max (t = {self.at_s:.4g} s); "
+                f"its error, estimated at {self.factor:g}x that, is over the budget ({self.budget_rms:g} RMS, "
+                f"{self.budget_max:g} max); simulate it at a shorter --dt (dt_s = {self.dt_s / 10:g}, say) "
+                f"and compare")
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the fields, the estimate and whether it is within the budget."""
+        return {**dataclasses.asdict(self), "factor": self.factor, "estimated_rms": self.estimated_rms,
+                "estimated_max": self.estimated_max, "within": self.within}
+
+
+def checked_by_default(params) -> bool:
+    """Whether ``smafinger simulate`` checks a run's step unless told: on a slider pulled directly
+    by its wire (a wire-slider mode, :func:`.engine.numerics.wire_mode_omega`), where the
+    reference is not validated on every set; not on the finger joint, where the defaults were
+    validated on every scenario (docs/speed.md)."""
+    from .engine.numerics import wire_mode_omega
+
+    return wire_mode_omega(params) is not None
+
+
+def check_step(result, engine: str = "compiled", progress=False) -> StepCheck:
+    """``result``'s coordinate against the same run at half its step.
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A run (decimated or not).
+    engine : {"compiled", "interpreted", "auto"}
+        The engine of the run at half the step (:func:`smafinger.engine.run.run_spec`).
+    progress : bool or smafinger.progress.Display
+        Show that run's progress (:func:`smafinger.engine.run.run_spec`).
+
+    Returns
+    -------
+    StepCheck
+
+    Raises
+    ------
+    ValueError
+        The run's step is one clock tick (1 ns): it has no half.
+    SimulationError
+        The run at half the step stopped (its message says so).
+    """
+    from .engine.clock import TICK_S, to_ticks
+    from .engine.run import SimulationError, run_spec
+
+    spec = result.spec
+    ticks = to_ticks("dt_s", spec.dt_s)
+    if ticks < 2:
+        raise ValueError(f"dt_s = {spec.dt_s!r} s is the clock's tick (1 ns): no shorter step to check it against")
+    half = dataclasses.replace(spec, dt_s=(ticks // 2) * TICK_S)
+    try:
+        other = run_spec(half, progress=progress, engine=engine, record="metrics")
+    except SimulationError as exc:
+        raise SimulationError(f"step check: the same run at dt_s = {half.dt_s:g} stopped: {exc}") from None
+    coord = spec.params.coordinate
+    name = f"{coord.name}_{coord.unit}"
+    a = np.asarray(result.signal(name))
+    b = np.asarray(other.signal(name))[::result.samples_every]
+    diff = a - b
+    i = int(np.argmax(np.abs(diff)))
+    return StepCheck(signal=name, dt_s=spec.dt_s, check_dt_s=half.dt_s, rms=float(np.sqrt(np.mean(diff ** 2))),
+                     max=float(abs(diff[i])), at_s=float(result.t[i]), budget_rms=coord.accuracy_rms,
+                     budget_max=coord.accuracy_max)
+
+
+def with_step_check(result, engine: str = "compiled", progress=False):
+    """``result`` with its :class:`StepCheck` (``result.step_check``; its warning among the
+    metrics' warnings when the estimate is over the budget)."""
+    return dataclasses.replace(result, step_check=check_step(result, engine, progress), _metrics=None)
+
+
+__all__ = ["ASSUMED_ORDER", "StepCheck", "check_step", "checked_by_default", "with_step_check"]

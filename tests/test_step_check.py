@@ -1,0 +1,112 @@
+"""The step check (smafinger.step_check): a run against the same run at half its step.
+
+Richardson's estimate on the smooth case of the convergence test (an error of known order), a
+light, undamped rig the reference step does not hold (found by a random search of the rig,
+docs/speed.md) flagged with its true error over the budget, the template rig within it, and the
+command's default (on for the rig, off for the joint).
+"""
+
+import json
+import math
+import types
+
+import numpy as np
+import pytest
+
+from smafinger.cli import main
+from smafinger.engine.numerics import reference_dt
+from smafinger.engine.run import make_spec, run_spec, simulate
+from smafinger.parameters import get
+from smafinger.step_check import ASSUMED_ORDER, check_step, checked_by_default, with_step_check
+from test_engine import smooth_case
+
+#: the rig of a random search's run 21-276 (docs/speed.md, "The linear rig"): a 2 m wire pulling
+#: 2.3 g, damping ratio 0.04, full duty cut at 1.34 s; RK4 at its reference step (0.5 ms, 0.69 rad
+#: of the wire-slider mode) damps the slider's ringing. No plausibility warning.
+LIGHT_RIG = dict(
+    wire_diameter_m=0.000388086, wire_length_m=1.98749, resistance_ohm_per_m=6.45516, eps_R=0.0144039,
+    bias_spring_preload_N=2.42716, external_force_N=0.0, bias_spring_K_N_m=13.5035, A_S0_C=42.8966,
+    A_F0_C=57.8086, M_S0_C=19.9691, M_F0_C=9.51525, T_amb_C=1.64332, T_init_C=1.64332,
+    h0_heating_W_m2K=43.0298, h2_heating_W_m2K3=0.0, h0_cooling_W_m2K=192.81, h2_cooling_W_m2K3=0.0,
+    V_H_V=15.871, V_L_V=1.52675, slider_mass_kg=0.00228185, viscous_damping_N_s_m=0.252778,
+    static_friction_N=0.212982, coulomb_friction_N=0.0762727, stroke_max_m=0.0858828, stroke_min_m=-0.000204104,
+    xi_init=1.0, c_A_Pa_per_C=6073650.0, c_M_Pa_per_C=13686700.0, pwm_period_s=0.001, D_A_Pa=73325100000.0,
+    D_M_Pa=30472000000.0)
+LIGHT_RIG_RUN = dict(strategy="open-loop", voltage="0:1.0,1.3367:0", drive="duty", t_end_s=6.2)
+
+
+def _error(result, truth, name):
+    e = result.signal(name) - truth.signal(name)
+    return float(np.sqrt(np.mean(e ** 2))), float(np.max(np.abs(e)))
+
+
+@pytest.mark.parametrize("method, low, high", [("euler", 0.8, 1.25), ("rk4", 1.5, 2.5)])
+def test_estimate_against_the_true_error_on_a_smooth_case(method, low, high):
+    """First order: the estimate (twice the difference) is the error; fourth order: about 2 x 16/15
+    times it, the overestimate the module docstring states."""
+    assert ASSUMED_ORDER == 1
+    p = smooth_case()
+    run = dict(strategy="open-loop", voltage="0:8:0", t_end_s=0.4, output_interval_s=0.01)
+    r = simulate(p, **run, dt_s=1e-3, method=method, check_step=True)
+    truth = simulate(p, **run, dt_s=1e-5, method="rk4")
+    rms, worst = _error(r, truth, "theta_deg")
+    chk = r.step_check
+    assert chk.check_dt_s == 5e-4 and chk.factor == 2.0
+    assert worst > 0 and low < chk.estimated_max / worst < high, (chk, worst)
+    assert low < chk.estimated_rms / rms < high, (chk, rms)
+
+
+def test_a_light_undamped_rig_is_flagged_and_is_over_the_budget():
+    p = get("linear-bias-spring").replace(**LIGHT_RIG)
+    spec = make_spec(p, **LIGHT_RIG_RUN)
+    assert spec.method == "rk4" and spec.dt_s == reference_dt(p) == 5e-4  # the reference
+    r = run_spec(spec)
+    assert r.metrics["warnings"] == []  # nothing else says so
+    checked = with_step_check(r)
+    chk = checked.step_check
+    truth = run_spec(make_spec(p, **LIGHT_RIG_RUN, dt_s=5e-5, method="rk4"))
+    rms, worst = _error(r, truth, "position_m")
+    assert rms > p.coordinate.accuracy_rms  # the error is over the budget...
+    assert not chk.within and chk.estimated_rms >= rms  # ...and the check says so, not less
+    assert [w for w in checked.metrics["warnings"] if "has not converged at its step" in w]
+    assert checked.summary()["step_check"]["within"] is False
+    assert r.step_check is None  # the unchecked result is left as it was
+
+
+def test_the_template_rig_is_within_the_budget_and_checked_by_default():
+    p = get("linear-bias-spring")
+    assert checked_by_default(p) and not checked_by_default(get("paper2010"))
+    r = simulate(p, "open-loop", voltage="0:0.6,6:0,12:0.4,18:0", drive="duty", t_end_s=25.0, check_step=True)
+    chk = r.step_check
+    assert chk.within and 0 < chk.rms < chk.budget_rms and chk.signal == "position_m"
+    assert not [w for w in r.metrics["warnings"] if "converged" in w]
+
+
+def test_deterministic_and_decimated():
+    r = simulate("linear-bias-spring", "open-loop", voltage="0:0.6,3:0", drive="duty", t_end_s=6.0)
+    a, b = check_step(r), check_step(r)
+    assert a == b
+    d = check_step(r.decimated(10))  # the same samples, every tenth
+    assert d.max <= a.max and d.check_dt_s == a.check_dt_s
+
+
+def test_a_one_tick_step_has_no_half():
+    spec = make_spec("paper2010", "cooperative", "0:-30", t_end_s=1.0)
+    fake = types.SimpleNamespace(spec=spec.__class__(**{**spec.__dict__, "dt_s": 1e-9}))
+    with pytest.raises(ValueError, match="dt_s = 1e-09 s is the clock's tick"):
+        check_step(fake)
+
+
+def test_simulate_command_checks_the_rig_by_default_and_the_joint_when_asked(tmp_path, capsys):
+    rig = ["simulate", "--params", "linear-bias-spring", "--strategy", "open-loop", "--duty", "0:0.6,3:0",
+           "--t-end", "6", "--no-progress"]
+    joint = ["simulate", "--profile", "0:-30", "--t-end", "2", "--no-progress"]
+    for args, checked, signal in ((rig, True, "position_m"), (rig + ["--no-check-step"], False, None),
+                                  (joint, False, None), (joint + ["--check-step"], True, "theta_deg")):
+        out = tmp_path / "s.json"
+        assert main([*args, "--summary", str(out)]) == 0
+        doc = json.loads(out.read_text())
+        assert ("step_check" in doc) == checked and ("step check:" in capsys.readouterr().out) == checked, args
+        if checked:
+            chk = doc["step_check"]
+            assert chk["signal"] == signal and chk["check_dt_s"] == chk["dt_s"] / 2 and math.isfinite(chk["rms"]) and chk["within"] is True
