@@ -110,3 +110,77 @@ def test_simulate_command_checks_the_rig_by_default_and_the_joint_when_asked(tmp
         if checked:
             chk = doc["step_check"]
             assert chk["signal"] == signal and chk["check_dt_s"] == chk["dt_s"] / 2 and math.isfinite(chk["rms"]) and chk["within"] is True
+
+
+def test_identify_actuator_checks_the_step_of_every_predicted_run(tmp_path):
+    """`identify actuator` simulates each run at half the fit's step too: the light rig's run is
+    reported as not converged, the template's is within the budget."""
+    from typer.testing import CliRunner
+
+    from smafinger.analysis import bench_synth as bs
+    from smafinger.cli import app
+    from smafinger.parameters.files import to_toml
+
+    light = get("linear-bias-spring").replace(**LIGHT_RIG)
+    for name, p in (("light", light), ("template", get("linear-bias-spring"))):
+        (tmp_path / f"{name}.toml").write_text(to_toml(p))
+        bs.write_csv(tmp_path / f"{name}.csv", bs.open_loop_run(p, LIGHT_RIG_RUN["voltage"], LIGHT_RIG_RUN["t_end_s"], seed=1))
+    reports = {}
+    for name in ("light", "template"):
+        r = CliRunner().invoke(app, ["identify", "actuator", "--params", str(tmp_path / f"{name}.toml"), "--validate",
+                                     str(tmp_path / f"{name}.csv"), "--report", str(tmp_path / f"{name}.json"),
+                                     "--workers", "1", "--no-progress"])
+        assert r.exit_code == 0, r.output
+        reports[name] = (json.loads((tmp_path / f"{name}.json").read_text())["files"][0]["step_check"], r.output)
+    light_check, light_out = reports["light"]
+    assert light_check["within"] is False and "has not converged at the run's step" in light_out
+    template_check, template_out = reports["template"]
+    assert template_check["within"] is True and "converged" not in template_out
+
+
+def test_checking_a_decimated_result_keeps_its_full_resolution_metrics():
+    r = simulate("linear-bias-spring", "cooperative", "0:0.010,15:0.004", t_end_s=30.0).decimated(50)
+    checked = with_step_check(r)
+    before, after = r.metrics, checked.metrics
+    assert {k: v for k, v in after.items() if k != "warnings"} == {k: v for k, v in before.items() if k != "warnings"}
+    added = [w for w in after["warnings"] if w not in before["warnings"]]
+    assert len(added) == 1 and "a closed loop can amplify" in added[0]  # the rig's closed loop: not converged
+    again = with_step_check(checked)  # checked twice: one warning, not two
+    assert again.metrics["warnings"] == after["warnings"]
+
+
+def test_the_api_refuses_a_bad_check_step_and_a_step_with_no_half():
+    with pytest.raises(TypeError, match="check_step = 'no' is not True or False"):
+        simulate("paper2010", "cooperative", "0:-30", t_end_s=1.0, check_step="no")
+    with pytest.raises(ValueError, match="clock's tick"):
+        simulate("paper2010", "cooperative", "0:-30", t_end_s=1e-6, output_interval_s=1e-6, dt_s=1e-9, check_step=True)
+
+
+def test_a_replay_keeps_the_choice_and_a_one_tick_step_is_refused_or_skipped(tmp_path, capsys):
+    first, again = tmp_path / "a.json", tmp_path / "b.json"
+    assert main(["simulate", "--profile", "0:-30", "--t-end", "2", "--check-step", "--summary", str(first),
+                 "--no-progress"]) == 0
+    assert main(["simulate", "--from", str(first), "--summary", str(again), "--no-progress"]) == 0
+    a, b = (json.loads(f.read_text()) for f in (first, again))
+    assert a.pop("wall_s") and b.pop("wall_s") and a == b and "step_check" in a
+    tick = ["simulate", "--params", "linear-bias-spring", "--strategy", "open-loop", "--duty", "0:0.6", "--t-end",
+            "1e-6", "--output-interval", "1e-6", "--dt", "1e-9", "--summary", str(tmp_path / "t.json"), "--no-progress"]
+    capsys.readouterr()
+    assert main(tick) == 0 and "the step was not checked" in capsys.readouterr().err
+    assert main(tick[:-3] + ["--check-step", "--summary", str(tmp_path / "u.json")]) == 2
+    assert not (tmp_path / "u.json").exists()
+
+
+def test_the_check_under_auto_runs_on_the_engine_the_run_used():
+    from smafinger.engine.interpreted import INTERPRETED_LIMIT_S, interpreted_estimate_s
+    from smafinger.step_check import check_engine, half_step
+
+    def ran(engine, t_end_s):
+        spec = make_spec("linear-bias-spring", "open-loop", voltage="0:0.3", drive="duty", t_end_s=t_end_s)
+        return types.SimpleNamespace(engine=engine, spec=spec)
+
+    short, long_ = ran("interpreted", 2.0), ran("interpreted", 600.0)
+    assert interpreted_estimate_s(half_step(long_.spec)) > INTERPRETED_LIMIT_S
+    assert check_engine(short, "auto") == "interpreted" and check_engine(long_, "auto") is None
+    assert check_engine(ran("compiled", 600.0), "auto") == "compiled"
+    assert check_engine(long_, "interpreted") == "interpreted"  # asked for: as asked

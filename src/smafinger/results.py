@@ -156,6 +156,13 @@ class SimulationResult:
         out.commit()
 
     # ---- metrics ---------------------------------------------------------------------
+    def step_check_warning(self) -> str | None:
+        """The step check's warning (None: not checked, or within the budget), worded for a
+        closed loop where the run has one (:meth:`.step_check.StepCheck.warning`)."""
+        if self.step_check is None:
+            return None
+        return self.step_check.warning(closed_loop=self.spec.strategy != "open-loop")
+
     @property
     def metrics(self) -> dict:
         if self._metrics is None:
@@ -246,7 +253,7 @@ def compute_metrics(result: SimulationResult) -> dict:
 
 def _step_warning(result: SimulationResult) -> list[str]:
     """The step check's warning, if the run was checked and is over the budget (:mod:`.step_check`)."""
-    w = None if result.step_check is None else result.step_check.warning()
+    w = result.step_check_warning()
     return [] if w is None else [w]
 
 

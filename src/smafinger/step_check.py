@@ -76,15 +76,23 @@ class StepCheck:
                 f"{'within' if self.within else 'over'} the budget ({self.budget_rms:g} {u} RMS, "
                 f"{self.budget_max:g} {u} max)")
 
-    def warning(self) -> str | None:
-        """The warning of a run whose estimated error is over the budget (None if within)."""
+    def warning(self, closed_loop: bool = False) -> str | None:
+        """The warning of a run whose estimated error is over the budget (None if within);
+        ``closed_loop``: the run is under a controller, whose loop can amplify differences below
+        any step's error (docs/speed.md), so a shorter step need not settle it."""
         if self.within:
             return None
-        return (f"the run has not converged at its step: against the same run at half the step its {self.signal} "
-                f"differs by {self.rms:.3g} {self.unit} RMS, {self.max:.3g} {self.unit} max (t = {self.at_s:.4g} s); "
-                f"its error, estimated at {self.factor:g}x that, is over the budget ({self.budget_rms:g} RMS, "
-                f"{self.budget_max:g} max); simulate it at a shorter --dt (dt_s = {self.dt_s / 10:g}, say) "
-                f"and compare")
+        u = self.unit
+        if closed_loop:
+            advice = ("a closed loop can amplify differences below any step's error, so a shorter --dt need not "
+                      "settle it: read its reach times and overshoots as one run's, and compare statistics over "
+                      "runs (docs/speed.md)")
+        else:
+            advice = f"simulate it at a shorter --dt (dt_s = {self.dt_s / 10:g}, say) and compare"
+        return (f"the run has not converged at its step (dt_s = {self.dt_s:g}): against the same run at dt_s = "
+                f"{self.check_dt_s:g} its {self.signal} differs by {self.rms:.3g} {u} RMS, {self.max:.3g} {u} max "
+                f"(t = {self.at_s:.4g} s); its error, estimated at {self.factor:g}x that, is over the budget "
+                f"({self.budget_rms:g} {u} RMS, {self.budget_max:g} {u} max); {advice}")
 
     def to_dict(self) -> dict:
         """JSON-ready: the fields, the estimate and whether it is within the budget."""
@@ -125,33 +133,78 @@ def check_step(result, engine: str = "compiled", progress=False) -> StepCheck:
     SimulationError
         The run at half the step stopped (its message says so).
     """
-    from .engine.clock import TICK_S, to_ticks
     from .engine.run import SimulationError, run_spec
 
     spec = result.spec
-    ticks = to_ticks("dt_s", spec.dt_s)
-    if ticks < 2:
-        raise ValueError(f"dt_s = {spec.dt_s!r} s is the clock's tick (1 ns): no shorter step to check it against")
-    half = dataclasses.replace(spec, dt_s=(ticks // 2) * TICK_S)
+    half = half_step(spec)
     try:
         other = run_spec(half, progress=progress, engine=engine, record="metrics")
-    except SimulationError as exc:
-        raise SimulationError(f"step check: the same run at dt_s = {half.dt_s:g} stopped: {exc}") from None
+    except SimulationError as exc:  # the same class (DutyNotANumber stays one)
+        raise type(exc)(f"step check: the run at dt_s = {spec.dt_s:g} finished, the same run at dt_s = "
+                        f"{half.dt_s:g} stopped (--no-check-step skips the check): {exc}") from None
     coord = spec.params.coordinate
     name = f"{coord.name}_{coord.unit}"
-    a = np.asarray(result.signal(name))
-    b = np.asarray(other.signal(name))[::result.samples_every]
-    diff = a - b
+    return compare(spec, result.t, result.signal(name), other.signal(name)[::result.samples_every], half.dt_s)
+
+
+def uncheckable(spec) -> str | None:
+    """Why ``spec``'s step cannot be checked (None: it can): a step of one clock tick (1 ns) has
+    no shorter one."""
+    from .engine.clock import to_ticks
+
+    if to_ticks("dt_s", spec.dt_s) < 2:
+        return f"dt_s = {spec.dt_s!r} s is the clock's tick (1 ns): there is no shorter step to check it against"
+    return None
+
+
+def half_step(spec):
+    """``spec`` (a :class:`~smafinger.engine.run.RunSpec`) at half its step, to the clock's tick
+    below; ValueError where :func:`uncheckable` says why not."""
+    from .engine.clock import TICK_S, to_ticks
+
+    why = uncheckable(spec)
+    if why is not None:
+        raise ValueError(why)
+    return dataclasses.replace(spec, dt_s=(to_ticks("dt_s", spec.dt_s) // 2) * TICK_S)
+
+
+def check_engine(result, setting: str) -> str | None:
+    """The engine of ``result``'s run at half the step under the engine ``setting``: the one
+    ``result`` ran on if ``setting`` is ``auto`` (so that the check never compiles in the
+    foreground after a run interpreted while the kernel compiles); None where that run would be
+    interpreted and is estimated over :data:`.engine.interpreted.INTERPRETED_LIMIT_S` (not checked
+    then: run it again once the kernel is compiled)."""
+    from .engine.interpreted import INTERPRETED_LIMIT_S, interpreted_estimate_s
+
+    if setting != "auto":
+        return setting
+    if result.engine == "interpreted" and interpreted_estimate_s(half_step(result.spec)) > INTERPRETED_LIMIT_S:
+        return None
+    return result.engine
+
+
+def compare(spec, t_s, q, q_check, check_dt_s: float) -> StepCheck:
+    """The :class:`StepCheck` of a run of ``spec`` whose coordinate (user unit) was ``q`` at the
+    times ``t_s`` [s] and ``q_check`` at the same times when run at ``check_dt_s``."""
+    coord = spec.params.coordinate
+    diff = np.asarray(q, dtype=np.float64) - np.asarray(q_check, dtype=np.float64)
     i = int(np.argmax(np.abs(diff)))
-    return StepCheck(signal=name, dt_s=spec.dt_s, check_dt_s=half.dt_s, rms=float(np.sqrt(np.mean(diff ** 2))),
-                     max=float(abs(diff[i])), at_s=float(result.t[i]), budget_rms=coord.accuracy_rms,
-                     budget_max=coord.accuracy_max)
+    return StepCheck(signal=f"{coord.name}_{coord.unit}", dt_s=spec.dt_s, check_dt_s=check_dt_s,
+                     rms=float(np.sqrt(np.mean(diff ** 2))), max=float(abs(diff[i])), at_s=float(t_s[i]),
+                     budget_rms=coord.accuracy_rms, budget_max=coord.accuracy_max)
 
 
 def with_step_check(result, engine: str = "compiled", progress=False):
-    """``result`` with its :class:`StepCheck` (``result.step_check``; its warning among the
-    metrics' warnings when the estimate is over the budget)."""
-    return dataclasses.replace(result, step_check=check_step(result, engine, progress), _metrics=None)
+    """``result`` with its :class:`StepCheck` (``result.step_check``) and its metrics as they
+    were (a decimated result's are at full resolution), with the check's warning among their
+    warnings when the estimate is over the budget (any earlier check's replaced)."""
+    chk = check_step(result, engine, progress)
+    m = result.metrics
+    old = [] if result.step_check is None else [result.step_check_warning()]
+    new = dataclasses.replace(result, step_check=chk)
+    warnings = [w for w in m["warnings"] if w not in old] + [w for w in [new.step_check_warning()] if w]
+    return dataclasses.replace(new, _metrics={**m, "warnings": warnings})
 
 
-__all__ = ["ASSUMED_ORDER", "StepCheck", "check_step", "checked_by_default", "with_step_check"]
+__all__ = ["ASSUMED_ORDER", "StepCheck", "check_engine", "check_step", "checked_by_default", "compare", "half_step",
+           "uncheckable", "with_step_check"]

@@ -12,6 +12,10 @@ of its position (or angle) sensor is:
 
 Each run's ``rms_offset_fitted_*`` also gives the RMS error with the offset that suits the run
 best: the part of the error that no choice of offset removes.
+
+Each run is also simulated at half the fit's step (:mod:`smafinger.step_check`): its
+``step_check`` says whether the model at this set has converged at that step, since a fit to a
+trajectory that has not would fit the step's error too (:func:`step_notes`).
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ import numpy as np
 
 from ..engine.batch import iter_batch
 from ..parameters import ParameterSet
+from ..step_check import StepCheck, compare, half_step
 from .actuator_eval import coordinate_signal
 from .bench_runs import MIN_NOISE_SAMPLES, BenchRun, coordinate_column, output_si_name
 from .fit_uncertainty import lag1_autocorrelation
@@ -61,6 +66,8 @@ class RunPrediction:
     model: np.ndarray | None
     curve: tuple[np.ndarray, np.ndarray] | None
     error: str | None = None
+    #: the run against the same run at half the step (None where either failed)
+    step: StepCheck | None = None
 
     @property
     def residuals(self) -> np.ndarray | None:
@@ -88,20 +95,26 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
         raise ValueError(f"offset policy {policy!r} is not one of {', '.join(OFFSET_POLICIES)}")
     fitted_offsets = fitted_offsets or {}
     column = coordinate_column(p)
-    specs, failed = [], {}
+    specs, failed = {}, {}
     for k, run in enumerate(runs):
         try:
-            specs.append((k, run.spec(p, dt_s)))
+            specs[k] = run.spec(p, dt_s)
         except ValueError as exc:
             failed[k] = f"{type(exc).__name__}: {exc}"
+    keys = list(specs)
+    halves = {k: half_step(specs[k]) for k in keys}  # in the same batch: one pass over the pool
     curves: dict[int, np.ndarray] = {}
-    keys = [k for k, _ in specs]
-    for j, ok, value in iter_batch([s for _, s in specs], pool=pool, reduce=partial(coordinate_signal, column=column),
-                                   record="metrics"):
-        if ok:
-            curves[keys[j]] = value
-        else:
-            failed[keys[j]] = f"{type(value).__name__}: {value}"
+    checks: dict[int, np.ndarray] = {}
+    for j, ok, value in iter_batch([specs[k] for k in keys] + [halves[k] for k in keys], pool=pool,
+                                   reduce=partial(coordinate_signal, column=column), record="metrics"):
+        k = keys[j % len(keys)]
+        if j < len(keys):
+            if ok:
+                curves[k] = value
+            else:
+                failed[k] = f"{type(value).__name__}: {value}"
+        elif ok:
+            checks[k] = value
     out = []
     for k, run in enumerate(runs):
         if policy == "none":
@@ -115,8 +128,39 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
             continue
         y = curves[k]
         grid = np.round(np.arange(y.size) * run.output_interval_s, 9)
-        out.append(RunPrediction(run, offset, method, se, run.model_output(y, p), (grid, y / p.coordinate.scale)))
+        step = compare(specs[k], grid, y, checks[k], halves[k].dt_s) if k in checks else None
+        out.append(RunPrediction(run, offset, method, se, run.model_output(y, p), (grid, y / p.coordinate.scale),
+                                 step=step))
     return out
+
+
+def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bool) -> list[str]:
+    """A note naming the runs whose model at ``p`` has not converged at the step they were
+    simulated at (their error, estimated from the run at half the step, over the coordinate's
+    accuracy budget), and one naming those whose run at half the step failed. ``fitted``: ``p``
+    is a fit's (whose values then absorb the error of the fitted runs among them)."""
+    notes = []
+    over = [pr for pr in predictions if pr.step is not None and not pr.step.within]
+    if over:
+        factor, unit, _ = DISPLAY[output_si_name(p)]
+        shown = factor / p.coordinate.scale  # the check's user unit -> the display unit
+
+        def err(x: float) -> str:
+            return f"{shown * x:.3g} {unit}"
+
+        c = over[0].step
+        runs = "; ".join(f"{Path(pr.run.file).name} ({pr.run.role}): {err(pr.step.estimated_rms)} RMS, "
+                         f"{err(pr.step.estimated_max)} max" for pr in over)
+        notes.append(f"the model at this set has not converged at the {'fit' if fitted else 'run'}'s step "
+                     f"(dt_s = {c.dt_s:g}): its error, estimated at {c.factor:g}x its difference from the same run "
+                     f"at half the step, is over the budget ({err(c.budget_rms)} RMS, {err(c.budget_max)} max) on "
+                     f"{runs}" + ("; the fitted values absorb that error too"
+                                  if fitted and any(pr.run.role == "fit" for pr in over) else ""))
+    lost = [pr for pr in predictions if pr.model is not None and pr.step is None]
+    if lost:
+        notes.append("the run at half the step failed on " + ", ".join(Path(pr.run.file).name for pr in lost)
+                     + ": the step was not checked there")
+    return notes
 
 
 def files_report(predictions: Sequence[RunPrediction], p: ParameterSet,
@@ -135,6 +179,8 @@ def files_report(predictions: Sequence[RunPrediction], p: ParameterSet,
                "figure": figures.get(pr.run.file)}
         if pr.run.mode == "closed-loop":
             row[f"reference_offset_{u}"] = pr.run.reference_offset
+        if pr.step is not None:
+            row["step_check"] = pr.step.to_dict()
         if pr.error:
             row["error"] = pr.error
         rows.append(row)

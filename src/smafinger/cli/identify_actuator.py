@@ -212,9 +212,10 @@ def _compute(setup: dict, show: bool) -> dict:
         p = fit.params if fit else setup["p"]
         offsets = {f: (fit.offsets[f], fit.offset_stderr[f]) for f in fit.offsets} if fit else {}
         predictions = ar.predict_runs(runs, p, pool, offsets, setup["offset"], s.dt_s)
+    steps = ar.step_notes(predictions, p, fit is not None)  # whether the model converged at the step
     if fit is not None:  # whether the fit reaches the noise: warned and in the report's notes
-        fit.notes.extend(ar.misfit_notes(predictions, p))
-    return {"fit": fit, "p": p, "predictions": predictions}
+        fit.notes.extend(ar.misfit_notes(predictions, p) + steps)
+    return {"fit": fit, "p": p, "predictions": predictions, "step_notes": steps}
 
 
 def _outputs(setup: dict, result: dict, wall_s: float) -> tuple[list[tuple[Path, Callable[[str], None]]], dict]:
@@ -310,7 +311,8 @@ def _print(setup: dict, result: dict) -> None:
         typer.echo(f"{Path(pr.run.file).name[:28]:<28} {pr.run.role:<9} {pr.run.mode:<12} {rms:>10} {mx:>10} "
                    f"{factor * pr.offset:>10.4g}  ({pr.offset_method})")
     sys.stdout.flush()
-    for note in (fit.notes + [f"at a bound: {', '.join(fit.at_bounds)}"] * bool(fit.at_bounds)) if fit else []:
+    for note in (fit.notes + [f"at a bound: {', '.join(fit.at_bounds)}"] * bool(fit.at_bounds)) if fit else \
+            result["step_notes"]:
         typer.echo(f"warning: {note}", err=True)
     for pr in preds:
         if pr.error:

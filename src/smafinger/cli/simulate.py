@@ -88,7 +88,7 @@ def simulate(
     from ..export import add_plot, add_signals, add_summary
     from ..files import Outputs
     from ..plausibility import blowup_hint
-    from ..step_check import checked_by_default, with_step_check
+    from ..step_check import check_engine, with_step_check
 
     _check_outputs(out, summary, plot)
     try:
@@ -97,15 +97,22 @@ def simulate(
         raise UsageError(str(exc)) from None
     spec, extra = _spec(ctx, params, set_, scenario, from_, strategy, profile, voltage, duty, current, t_end, dt,
                         method, pwm, output_interval, tol_deg, tol_m, hold_s)
+    checking = _check_choice(check_step, spec, extra)
     with progress_display(progress) as display:
         try:
             result = run_spec(spec, progress=display, engine=setting)
-            if checked_by_default(spec.params) if check_step is None else check_step:
-                result = with_step_check(result, setting, progress=display)
         except DutyNotANumber:  # the step is not what to change
             raise
         except SimulationError as exc:
             raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
+        if checking:  # its failure says it is the check's (a shorter step is no advice there)
+            check_with = check_engine(result, setting)
+            if check_with is None:
+                print("smafinger: note: the step was not checked: this run was interpreted while the kernel "
+                      "compiles, and the same run at half the step would take long interpreted; run it again "
+                      "once the kernel is compiled", file=sys.stderr)
+            else:
+                result = with_step_check(result, check_with, progress=display)
     outputs = Outputs()
     if out is not None:
         add_signals(outputs, result, out, "--out", **extra)
@@ -124,6 +131,30 @@ def simulate(
               "kernel, equal to rounding)" + ("" if setting != "auto" or INTERPRETED else
                                              ": the compiled kernel was not in numba's cache, and is being compiled "
                                              "in the background for the runs that follow"), file=sys.stderr)
+
+
+def _check_choice(flag: Optional[bool], spec, extra: dict) -> bool:
+    """Whether to check the run's step (:mod:`smafinger.step_check`): ``--check-step`` or
+    ``--no-check-step`` (recorded in ``extra``, the run's provenance), else what a replayed run
+    recorded, else the default (on a slider). Asked for where the step has no shorter one: a
+    usage error before the run; by default there: a note, and no check."""
+    from ..step_check import checked_by_default, uncheckable
+
+    recorded = extra.get("check_step")
+    if flag is not None:
+        extra["check_step"] = "on" if flag else "off"  # text: every output format holds it
+        want = flag
+    elif recorded in ("on", "off"):
+        want = recorded == "on"
+    else:
+        want = checked_by_default(spec.params)
+    why = uncheckable(spec) if want else None
+    if why is not None and flag:
+        raise UsageError(f"--check-step: {why}")
+    if why is not None:
+        print(f"smafinger: note: the step was not checked: {why}", file=sys.stderr)
+        return False
+    return want
 
 
 def _check_outputs(out: Path | None, summary: Path | None, plot: Path | None) -> None:

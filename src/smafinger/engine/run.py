@@ -384,6 +384,7 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         Run it again at half the step and compare (:mod:`smafinger.step_check`): the result's
         ``step_check``, and a warning among its metrics' if the error estimated from the
         difference is over the budget. ``smafinger simulate`` does this by default on a slider.
+        Under ``engine="auto"`` the check runs on the engine the run used.
 
     Returns
     -------
@@ -399,10 +400,16 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
                      tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
+    if not isinstance(check_step, (bool, np.bool_)):
+        raise TypeError(f"check_step = {check_step!r} is not True or False")
+    if check_step:
+        from ..step_check import half_step
+
+        half_step(spec)  # a step with no shorter one is refused before the run
     setting = interpreted.engine_setting(engine)
     result = run_spec(spec, progress=progress, engine=setting)
     if check_step:
         from ..step_check import with_step_check
 
-        result = with_step_check(result, setting)
+        result = with_step_check(result, result.engine if setting == "auto" else setting)
     return result
