@@ -184,3 +184,29 @@ def test_the_check_under_auto_runs_on_the_engine_the_run_used():
     assert check_engine(short, "auto") == "interpreted" and check_engine(long_, "auto") is None
     assert check_engine(ran("compiled", 600.0), "auto") == "compiled"
     assert check_engine(long_, "interpreted") == "interpreted"  # asked for: as asked
+
+
+def test_a_sweep_with_check_step_estimates_each_runs_error(tmp_path):
+    """`[sweep] check_step = true`: the light rig's row gets its estimated error over the budget and
+    the warning; the same rig well damped (damping ratio about 0.8) is within; without the key the
+    columns are NaN and the run ids the same."""
+    import pandas as pd
+
+    from smafinger.analysis.sweep import SweepSpecError, parse_spec, run_sweep
+
+    fixed = {k: v for k, v in LIGHT_RIG.items() if k != "viscous_damping_N_s_m"}
+    base = {"params": "linear-bias-spring", "set": fixed, **LIGHT_RIG_RUN}
+    vary = {"viscous_damping_N_s_m": {"values": [LIGHT_RIG["viscous_damping_N_s_m"], 5.0]}}
+    frames = {}
+    for check in (True, False):
+        spec = parse_spec({"base": base, "vary": vary, "sweep": {"check_step": check}})
+        run_sweep(spec, tmp_path / f"{check}.parquet", workers=1)
+        frames[check] = pd.read_parquet(tmp_path / f"{check}.parquet").sort_values("point")
+    on, off = frames[True], frames[False]
+    assert on["run_id"].tolist() == off["run_id"].tolist() and (on["status"] == "ok").all()
+    light, damped = on.iloc[0], on.iloc[1]
+    assert light["step_error_rms_m"] > 5e-5 and "has not converged at its step" in light["warnings"]
+    assert damped["step_error_rms_m"] < 5e-5 and damped["step_error_max_m"] < 6e-4 and not damped["warnings"]
+    assert on["step_error_rms_deg"].isna().all() and off[["step_error_rms_m", "step_error_max_m"]].isna().all().all()
+    with pytest.raises(SweepSpecError, match=r"\[sweep\] check_step: 'yes' is not true or false"):
+        parse_spec({"base": base, "vary": vary, "sweep": {"check_step": "yes"}})

@@ -123,9 +123,9 @@ def check_points(spec: SweepSpec, template, points, pool, traces_interval_s: flo
 # ---------------------------------------------------------------------------------------
 # the run pass
 # ---------------------------------------------------------------------------------------
-def _run_item(item, traces_interval_s, row):
+def _run_item(item, traces_interval_s, row, check_step=False):
     template, pts, ids, cols = item
-    return run_block(template, pts, ids, cols, traces_interval_s, row)
+    return run_block(template, pts, ids, cols, traces_interval_s, row, check_step)
 
 
 def _run_items(template, points, ids: np.ndarray, todo: np.ndarray, size: int):
@@ -261,7 +261,7 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
             backend = pool.describe()
             say.line(f"running {ran} runs on {backend}")
             size = chunk_size or spec.chunk_size or batch.auto_chunk_size(ran, pool.slots)
-            fn = partial(_run_item, traces_interval_s=traced, row=metrics_row)
+            fn = partial(_run_item, traces_interval_s=traced, row=metrics_row, check_step=spec.check_step)
             preload_writer()  # pandas' import (pyarrow's) overlaps the wait for the first rows
             failed, client_s = _run_pass(spec, pool, fn, _run_items(template, points, checked.ids, todo, size),
                                          _Saver(pdir, spec.save_interval_s, traced), say, done0, total, on_progress)

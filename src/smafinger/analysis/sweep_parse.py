@@ -19,7 +19,7 @@ from ..parameters.base import field_spec
 from .sweep_spec import DEFAULT_MAX_RUNS, MODES, RUN_KEYS, SweepSpec, SweepSpecError, Vary, scenario_spec
 
 BASE_KEYS = set(RUN_KEYS) | {"set", "scenario"}
-SWEEP_KEYS = {"mode", "samples", "seed", "chunk_size", "traces_interval_s", "name", "save_interval_s"}
+SWEEP_KEYS = {"mode", "samples", "seed", "chunk_size", "traces_interval_s", "name", "save_interval_s", "check_step"}
 VARY_KEYS = {"fields", "values", "start", "stop", "num", "min", "max", "log"}
 
 
@@ -191,8 +191,11 @@ def _parse_sweep(source: str, sweep: dict) -> dict[str, Any]:
     name = sweep.get("name", Path(source).stem if source != "<dict>" else "sweep")
     if not isinstance(name, str):
         raise _err(source, "[sweep] name", f"{name!r} is not a string")
+    check = sweep.get("check_step", False)
+    if not isinstance(check, bool):
+        raise _err(source, "[sweep] check_step", f"{check!r} is not true or false")
     return dict(mode=mode, samples=samples, seed=seed, chunk_size=chunk, traces_interval_s=tr,
-                save_interval_s=save, name=name)
+                save_interval_s=save, name=name, check_step=check)
 
 
 def _parse_vary(source: str, vname: str, entry, mode: str, b: dict, used_fields: dict[str, str],

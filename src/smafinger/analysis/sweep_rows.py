@@ -25,6 +25,7 @@ from ..engine.batch import FLOAT64_SIGNALS, warm_up
 from ..engine.run import run_spec
 from ..engine.signals import COORDINATE_NAMES
 from ..parameters import MECHANISMS
+from ..step_check import with_step_check
 from .sweep_spec import SPEC_ERRORS, SweepTemplate, run_id
 
 #: the joint has started to move once it is this far from its initial angle
@@ -59,8 +60,11 @@ METRIC_COLUMNS = (
     # the numerics the run used (engine.numerics: a point's varied values can change its default)
     "run_method", "run_dt_s", "run_pwm",
     # the run's warnings (its metrics': physically absurd results, smafinger.plausibility; a target never
-    # pursued), "; "-joined
+    # pursued; with [sweep] check_step, a step the run has not converged at), "; "-joined
     "warnings",
+    # with [sweep] check_step: the coordinate's error estimated from the same run at half the step
+    # (smafinger.step_check: twice the difference), RMS and largest, in its unit; NaN without
+    *(f"step_error_{stat}_{u}" for u in UNITS for stat in ("rms", "max")),
 )
 INT_COLUMNS = ("interlock_violations", "steps")
 #: text columns (the others are numbers)
@@ -95,7 +99,11 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
         "run_method": result.spec.method, "run_dt_s": float(result.spec.dt_s), "run_pwm": result.spec.pwm,
         "warnings": WARNINGS_SEPARATOR.join(s["warnings"]),
+        **{f"step_error_{stat}_{u}": math.nan for u in UNITS for stat in ("rms", "max")},
     })
+    chk = result.step_check
+    if chk is not None:
+        row[f"step_error_rms_{unit}"], row[f"step_error_max_{unit}"] = chk.estimated_rms, chk.estimated_max
     segs = {seg["index"]: seg for seg in s["segments"]}
     for i, seg_def in enumerate(result.spec.profile.segments):
         seg = segs.get(i)
@@ -200,13 +208,15 @@ class RowBlock:
 
 
 def run_block(template: SweepTemplate, points: list[int], ids: list[str], columns: dict[str, list],
-              traces_interval_s: float | None = None, row=metrics_row) -> RowBlock:
+              traces_interval_s: float | None = None, row=metrics_row, check_step: bool = False) -> RowBlock:
     """Run a chunk of points here, one row each (a failed run is a row with its error).
 
     ``ids`` are the run ids found by :func:`check_block`; each run's id is computed again
     from the spec that actually ran, and a difference fails the run rather than mislabel
     it. ``row`` makes a run's row (:func:`metrics_row`) from its metrics' signals: without
     traces a run records only those (``run_spec(record="metrics")``; the same row).
+    ``check_step``: each run also at half its step (:func:`smafinger.step_check.with_step_check`;
+    a failure of that run fails the run's row).
     """
     warm_up()
     rows, traces, failed = [], [], 0
@@ -216,7 +226,8 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
             if run_id(spec) != rid:
                 raise RuntimeError(f"internal error: point {point} was checked as run {rid} but builds "
                                    f"run {run_id(spec)}")
-            r = row(run_spec(spec, record="all" if traces_interval_s else "metrics"), traces_interval_s)
+            result = run_spec(spec, record="all" if traces_interval_s else "metrics")
+            r = row(with_step_check(result) if check_step else result, traces_interval_s)
         except Exception as exc:  # noqa: BLE001 - reported per run, the sweep goes on
             r = error_row(exc)
             failed += 1

@@ -253,6 +253,8 @@ class SweepSpec:
     source: str = "<dict>"
     base_dir: Path = field(default=Path("."), compare=False)
     save_interval_s: float = 1.0
+    #: every run also at half its step (:mod:`smafinger.step_check`): its ``step_error_*`` columns
+    check_step: bool = False
 
     def size(self) -> int:
         """How many runs, computed without making any point."""
@@ -335,4 +337,6 @@ class SweepSpec:
             "vary": [{"name": v.name, "fields": list(v.fields),
                       "values": list(v.values) if v.values is not None else None,
                       "min": v.low, "max": v.high, "log": v.log} for v in self.vary],
+            # only when on: the canonical form of a sweep without it (its table's metadata) is as before
+            **({"check_step": True} if self.check_step else {}),
         }
