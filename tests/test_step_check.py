@@ -210,3 +210,49 @@ def test_a_sweep_with_check_step_estimates_each_runs_error(tmp_path):
     assert on["step_error_rms_deg"].isna().all() and off[["step_error_rms_m", "step_error_max_m"]].isna().all().all()
     with pytest.raises(SweepSpecError, match=r"\[sweep\] check_step: 'yes' is not true or false"):
         parse_spec({"base": base, "vary": vary, "sweep": {"check_step": "yes"}})
+
+
+def test_a_sweep_turned_to_check_step_says_which_rows_it_did_not_check(tmp_path):
+    """Run ids do not change with check_step, so a sweep run without it and then with it keeps
+    its rows: the report and the metadata say how many were not checked (found by review); a
+    one-tick step is refused in the check pass."""
+    import pyarrow.parquet as pq
+
+    from smafinger.analysis.sweep import SweepSpecError, parse_spec, run_sweep
+
+    data = {"base": {"params": "linear-bias-spring", "strategy": "open-loop", "voltage": "0:0.6,1:0",
+                     "drive": "duty", "t_end_s": 2.0}, "vary": {"slider_mass_kg": {"values": [0.05, 0.1, 0.2]}}}
+    out = tmp_path / "s.parquet"
+    assert run_sweep(parse_spec(data), out, workers=1).unchecked_total == 0
+    rep = run_sweep(parse_spec({**data, "sweep": {"check_step": True}}), out, workers=1)
+    assert rep.resumed == 3 and rep.unchecked_total == 3
+    meta = json.loads(pq.read_schema(out).metadata[b"smafinger.sweep"])
+    assert meta["spec"]["check_step"] is True and meta["step_unchecked"] == 3
+    fresh = run_sweep(parse_spec({**data, "sweep": {"check_step": True}}), tmp_path / "f.parquet", workers=1)
+    assert fresh.unchecked_total == 0
+    tick = {"base": {**data["base"], "t_end_s": 1e-5, "output_interval_s": 1e-6},
+            "vary": {"dt_s": {"values": [2e-9, 1e-9]}}, "sweep": {"check_step": True}}
+    with pytest.raises(SweepSpecError, match=r"point 1 \(dt_s = 1e-09\).*clock's tick"):
+        run_sweep(parse_spec(tick), tmp_path / "t.parquet", workers=1)
+
+
+def test_identify_actuator_names_why_a_runs_check_failed(tmp_path, monkeypatch):
+    """A run at half the step that fails is named with its reason, in the warning and in the
+    report's files[].step_check and step_notes, with or without a fit (found by review)."""
+    import dataclasses
+
+    from smafinger.analysis import actuator_report as ar
+    from smafinger.analysis import bench_synth as bs
+    from smafinger.analysis.bench_runs import load_open_loop
+    from smafinger.engine.batch import make_pool
+
+    p = get("linear-bias-spring")
+    bs.write_csv(tmp_path / "a.csv", bs.open_loop_run(p, "0:0,0.2:0.5,2:0", 3.0, seed=1))
+    run = load_open_loop(tmp_path / "a.csv", None, "validate", p)
+    monkeypatch.setattr(ar, "half_step", lambda spec: dataclasses.replace(spec, dt_s=2 * spec.t_end_s))
+    with make_pool(1) as pool:
+        (pr,) = ar.predict_runs([run], p, pool)
+    assert pr.model is not None and pr.step is None and "longer than t_end_s" in pr.step_error
+    (note,) = ar.step_notes([pr], p, fitted=False)
+    assert "a.csv (validate): ValueError" in note and "longer than t_end_s" in note
+    assert ar.files_report([pr], p)[0]["step_check"] == {"error": pr.step_error}

@@ -110,7 +110,11 @@ def checked_by_default(params) -> bool:
     return wire_mode_omega(params) is not None
 
 
-def check_step(result, engine: str = "compiled", progress=False) -> StepCheck:
+#: what a failed check advises by default (``smafinger simulate``'s option)
+REMEDY = "--no-check-step skips the check"
+
+
+def check_step(result, engine: str = "compiled", progress=False, remedy: str = REMEDY) -> StepCheck:
     """``result``'s coordinate against the same run at half its step.
 
     Parameters
@@ -121,6 +125,8 @@ def check_step(result, engine: str = "compiled", progress=False) -> StepCheck:
         The engine of the run at half the step (:func:`smafinger.engine.run.run_spec`).
     progress : bool or smafinger.progress.Display
         Show that run's progress (:func:`smafinger.engine.run.run_spec`).
+    remedy : str
+        How to skip the check, told when that run stops.
 
     Returns
     -------
@@ -141,7 +147,7 @@ def check_step(result, engine: str = "compiled", progress=False) -> StepCheck:
         other = run_spec(half, progress=progress, engine=engine, record="metrics")
     except SimulationError as exc:  # the same class (DutyNotANumber stays one)
         raise type(exc)(f"step check: the run at dt_s = {spec.dt_s:g} finished, the same run at dt_s = "
-                        f"{half.dt_s:g} stopped (--no-check-step skips the check): {exc}") from None
+                        f"{half.dt_s:g} stopped ({remedy}): {exc}") from None
     coord = spec.params.coordinate
     name = f"{coord.name}_{coord.unit}"
     return compare(spec, result.t, result.signal(name), other.signal(name)[::result.samples_every], half.dt_s)
@@ -194,11 +200,11 @@ def compare(spec, t_s, q, q_check, check_dt_s: float) -> StepCheck:
                      budget_rms=coord.accuracy_rms, budget_max=coord.accuracy_max)
 
 
-def with_step_check(result, engine: str = "compiled", progress=False):
+def with_step_check(result, engine: str = "compiled", progress=False, remedy: str = REMEDY):
     """``result`` with its :class:`StepCheck` (``result.step_check``) and its metrics as they
     were (a decimated result's are at full resolution), with the check's warning among their
     warnings when the estimate is over the budget (any earlier check's replaced)."""
-    chk = check_step(result, engine, progress)
+    chk = check_step(result, engine, progress, remedy)
     m = result.metrics
     old = [] if result.step_check is None else [result.step_check_warning()]
     new = dataclasses.replace(result, step_check=chk)
@@ -206,5 +212,5 @@ def with_step_check(result, engine: str = "compiled", progress=False):
     return dataclasses.replace(new, _metrics={**m, "warnings": warnings})
 
 
-__all__ = ["ASSUMED_ORDER", "StepCheck", "check_engine", "check_step", "checked_by_default", "compare", "half_step",
+__all__ = ["ASSUMED_ORDER", "REMEDY", "StepCheck", "check_engine", "check_step", "checked_by_default", "compare", "half_step",
            "uncheckable", "with_step_check"]

@@ -68,6 +68,8 @@ class RunPrediction:
     error: str | None = None
     #: the run against the same run at half the step (None where either failed)
     step: StepCheck | None = None
+    #: why the run at half the step failed (None: it did not, or it was not made)
+    step_error: str | None = None
 
     @property
     def residuals(self) -> np.ndarray | None:
@@ -105,6 +107,7 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
     halves = {k: half_step(specs[k]) for k in keys}  # in the same batch: one pass over the pool
     curves: dict[int, np.ndarray] = {}
     checks: dict[int, np.ndarray] = {}
+    check_failed: dict[int, str] = {}
     for j, ok, value in iter_batch([specs[k] for k in keys] + [halves[k] for k in keys], pool=pool,
                                    reduce=partial(coordinate_signal, column=column), record="metrics"):
         k = keys[j % len(keys)]
@@ -115,6 +118,8 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
                 failed[k] = f"{type(value).__name__}: {value}"
         elif ok:
             checks[k] = value
+        else:
+            check_failed[k] = f"{type(value).__name__}: {value}"
     out = []
     for k, run in enumerate(runs):
         if policy == "none":
@@ -130,15 +135,21 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
         grid = np.round(np.arange(y.size) * run.output_interval_s, 9)
         step = compare(specs[k], grid, y, checks[k], halves[k].dt_s) if k in checks else None
         out.append(RunPrediction(run, offset, method, se, run.model_output(y, p), (grid, y / p.coordinate.scale),
-                                 step=step))
+                                 step=step, step_error=check_failed.get(k)))
     return out
+
+
+def _label(pr: RunPrediction) -> str:
+    """A run's name and what it is in the command (``fit``, ``validate``, ``replay``)."""
+    return f"{Path(pr.run.file).name} ({'replay' if pr.run.mode == 'closed-loop' else pr.run.role})"
 
 
 def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bool) -> list[str]:
     """A note naming the runs whose model at ``p`` has not converged at the step they were
     simulated at (their error, estimated from the run at half the step, over the coordinate's
-    accuracy budget), and one naming those whose run at half the step failed. ``fitted``: ``p``
-    is a fit's (whose values then absorb the error of the fitted runs among them)."""
+    accuracy budget), and one naming those whose run at half the step failed, with why.
+    ``fitted``: ``p`` is a fit's (whose values then absorb the error of the fitted runs among
+    them)."""
     notes = []
     over = [pr for pr in predictions if pr.step is not None and not pr.step.within]
     if over:
@@ -149,17 +160,22 @@ def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bo
             return f"{shown * x:.3g} {unit}"
 
         c = over[0].step
-        runs = "; ".join(f"{Path(pr.run.file).name} ({pr.run.role}): {err(pr.step.estimated_rms)} RMS, "
-                         f"{err(pr.step.estimated_max)} max" for pr in over)
+        runs = "; ".join(f"{_label(pr)}: {err(pr.step.estimated_rms)} RMS, {err(pr.step.estimated_max)} max"
+                         for pr in over)
+        tail = ""
+        if fitted and any(pr.run.role == "fit" for pr in over):
+            tail = "; the fitted values absorb that error too"
+        if any(pr.run.mode == "closed-loop" for pr in over):
+            tail += ("; a closed loop can amplify differences below any step's error, so a replay's error is "
+                     "one run's, not converged (docs/speed.md)")
         notes.append(f"the model at this set has not converged at the {'fit' if fitted else 'run'}'s step "
                      f"(dt_s = {c.dt_s:g}): its error, estimated at {c.factor:g}x its difference from the same run "
                      f"at half the step, is over the budget ({err(c.budget_rms)} RMS, {err(c.budget_max)} max) on "
-                     f"{runs}" + ("; the fitted values absorb that error too"
-                                  if fitted and any(pr.run.role == "fit" for pr in over) else ""))
-    lost = [pr for pr in predictions if pr.model is not None and pr.step is None]
+                     f"{runs}{tail}")
+    lost = [pr for pr in predictions if pr.step_error is not None]
     if lost:
-        notes.append("the run at half the step failed on " + ", ".join(Path(pr.run.file).name for pr in lost)
-                     + ": the step was not checked there")
+        notes.append("the run at half the step failed, so the step was not checked, on "
+                     + "; ".join(f"{_label(pr)}: {pr.step_error}" for pr in lost))
     return notes
 
 
@@ -181,6 +197,8 @@ def files_report(predictions: Sequence[RunPrediction], p: ParameterSet,
             row[f"reference_offset_{u}"] = pr.run.reference_offset
         if pr.step is not None:
             row["step_check"] = pr.step.to_dict()
+        elif pr.step_error is not None:
+            row["step_check"] = {"error": pr.step_error}
         if pr.error:
             row["error"] = pr.error
         rows.append(row)

@@ -97,11 +97,12 @@ class Checked:
 
 def check_points(spec: SweepSpec, template, points, pool, traces_interval_s: float | None = None) -> Checked:
     """Every point's run id, validated in ``pool``'s workers (with ``traces_interval_s``, its
-    traces' sampling too); refuses a bad or repeated point."""
+    traces' sampling too; with ``spec.check_step``, that its step can be checked); refuses a bad
+    or repeated point."""
     n = points.n
     ids = np.zeros(n, dtype="S16")
     block = max(16, min(CHECK_BLOCK, math.ceil(n / (4 * pool.slots))))
-    items = ((template, a, cols, traces_interval_s) for a, cols in points.blocks(block))
+    items = ((template, a, cols, traces_interval_s, spec.check_step) for a, cols in points.blocks(block))
     n_seg = 0
     for res in pool.map_tasks(_check_item, items):
         if res.error is not None:
@@ -169,6 +170,8 @@ class SweepReport:
     flagged_total: int = 0
     #: the client's own time in the run pass, per run that ran (s)
     client_s_per_run: float = math.nan
+    #: with ``check_step``: finished ``ok`` rows not step-checked (made by a pass without it)
+    unchecked_total: int = 0
 
 
 class _Saver:
@@ -272,11 +275,12 @@ def run_sweep(spec: SweepSpec | str | Path, out: str | Path | None = None, *, wo
     if not finished.done.all():
         raise RuntimeError(f"internal error: {int((~finished.done).sum())} runs have no result after the sweep")
     failed_total, flagged_total = finished.failed_count(), finished.flagged_count()
-    _merge(spec, out, pdir, finished, points, checked, traces, template)
+    unchecked = finished.unchecked_count() if spec.check_step else 0
+    _merge(spec, out, pdir, finished, points, checked, traces, template, unchecked)
     return SweepReport(out=out, traces_out=traces_path(out) if traces else None, total=total,
                        resumed=done0, ran=ran, failed=failed, wall_s=time.perf_counter() - t_start,
                        backend=backend, failed_total=failed_total, flagged_total=flagged_total,
-                       client_s_per_run=client_s)
+                       client_s_per_run=client_s, unchecked_total=unchecked)
 
 
 def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tuple[int, float]:
@@ -311,16 +315,17 @@ def _run_pass(spec, pool, fn, items, saver, say, done, total, on_progress) -> tu
 
 
 def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Checked, traces: bool,
-           template) -> None:
+           template, unchecked: int = 0) -> None:
     """Write ``OUT`` (and its traces) from the finished rows, with their provenance
-    (:mod:`.sweep_provenance`), then remove the parts."""
+    (:mod:`.sweep_provenance`), then remove the parts. ``unchecked``: with ``check_step``, the
+    finished rows made without it (in the metadata as ``step_unchecked``)."""
     from .. import __version__
     from .sweep_provenance import sweep_provenance
 
     canonical = json.loads(json.dumps(spec.canonical(), default=str))
     meta = finished.out_meta or {}
     unchanged = (finished.n_parts == 0 and meta.get("spec") == canonical
-                 and (not traces or meta.get("traces")))
+                 and (not traces or meta.get("traces")) and meta.get("step_unchecked", 0) == unchecked)
     if not unchanged:
         varied = [v.name for v in spec.vary]
         merge = uuid.uuid4().hex  # in both files: the traces' points are the table's (sweep_merge.same_merge)
@@ -331,7 +336,8 @@ def _merge(spec, out: Path, pdir: Path, finished: Finished, points, checked: Che
                           "merge": merge})
         write_table(out, finished, points, varied, checked.n_segments,
                     {"varied": varied, "spec": canonical, "version": __version__, "traces": traces, "merge": merge,
-                     "motion_threshold_deg": MOTION_THRESHOLD_DEG, "provenance": sweep_provenance(template)})
+                     "motion_threshold_deg": MOTION_THRESHOLD_DEG, "provenance": sweep_provenance(template),
+                     **({"step_unchecked": unchecked} if spec.check_step else {})})
     if pdir.is_dir():
         for f in pdir.iterdir():
             try:

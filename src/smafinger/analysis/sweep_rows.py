@@ -25,7 +25,7 @@ from ..engine.batch import FLOAT64_SIGNALS, warm_up
 from ..engine.run import run_spec
 from ..engine.signals import COORDINATE_NAMES
 from ..parameters import MECHANISMS
-from ..step_check import with_step_check
+from ..step_check import half_step, with_step_check
 from .sweep_spec import SPEC_ERRORS, SweepTemplate, run_id
 
 #: the joint has started to move once it is this far from its initial angle
@@ -50,6 +50,11 @@ def _unique(items) -> tuple:
 WIRE_NAMES = _unique(w for cls in MECHANISMS.values() for w in cls.wire_names)
 COORDINATES = _unique((cls.coordinate.name, cls.coordinate.unit) for cls in MECHANISMS.values())
 UNITS = _unique(unit for _, unit in COORDINATES)
+#: with [sweep] check_step: the coordinate's error estimated from the same run at half the step
+#: (smafinger.step_check: twice the difference), RMS and largest, in each unit; NaN without
+STEP_COLUMNS = tuple(f"step_error_{stat}_{u}" for u in UNITS for stat in ("rms", "max"))
+#: what a sweep's failed step check advises (its row's error)
+SWEEP_CHECK_REMEDY = "remove check_step from [sweep] to skip the check"
 #: per-run metric columns, in table order (then the per-segment ``seg{i}_*`` columns)
 METRIC_COLUMNS = (
     "status", "error",
@@ -62,9 +67,7 @@ METRIC_COLUMNS = (
     # the run's warnings (its metrics': physically absurd results, smafinger.plausibility; a target never
     # pursued; with [sweep] check_step, a step the run has not converged at), "; "-joined
     "warnings",
-    # with [sweep] check_step: the coordinate's error estimated from the same run at half the step
-    # (smafinger.step_check: twice the difference), RMS and largest, in its unit; NaN without
-    *(f"step_error_{stat}_{u}" for u in UNITS for stat in ("rms", "max")),
+    *STEP_COLUMNS,
 )
 INT_COLUMNS = ("interlock_violations", "steps")
 #: text columns (the others are numbers)
@@ -99,7 +102,7 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
         "run_method": result.spec.method, "run_dt_s": float(result.spec.dt_s), "run_pwm": result.spec.pwm,
         "warnings": WARNINGS_SEPARATOR.join(s["warnings"]),
-        **{f"step_error_{stat}_{u}": math.nan for u in UNITS for stat in ("rms", "max")},
+        **dict.fromkeys(STEP_COLUMNS, math.nan),
     })
     chk = result.step_check
     if chk is not None:
@@ -161,9 +164,10 @@ class CheckedBlock:
 
 
 def check_block(template: SweepTemplate, start: int, columns: dict[str, list],
-                traces_interval_s: float | None = None) -> CheckedBlock:
+                traces_interval_s: float | None = None, check_step: bool = False) -> CheckedBlock:
     """Build and validate the spec of every point of a block, and compute its run id; with
-    ``traces_interval_s``, check that each run can be traced at it (:func:`trace_step`).
+    ``traces_interval_s``, check that each run can be traced at it (:func:`trace_step`); with
+    ``check_step``, that its step has a shorter one (:func:`smafinger.step_check.half_step`).
 
     Stops at the first bad point: ``error = (point, values, message)``.
     """
@@ -176,6 +180,8 @@ def check_block(template: SweepTemplate, start: int, columns: dict[str, list],
             spec = template.build(values)
             if traces_interval_s:
                 trace_step(traces_interval_s, spec.output_interval_s)
+            if check_step:
+                half_step(spec)
         except SPEC_ERRORS as exc:
             return CheckedBlock(start, ids[:k], n_seg, (start + k, values, str(exc)))
         ids[k] = run_id(spec).encode()
@@ -227,7 +233,7 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
                 raise RuntimeError(f"internal error: point {point} was checked as run {rid} but builds "
                                    f"run {run_id(spec)}")
             result = run_spec(spec, record="all" if traces_interval_s else "metrics")
-            r = row(with_step_check(result) if check_step else result, traces_interval_s)
+            r = row(with_step_check(result, remedy=SWEEP_CHECK_REMEDY) if check_step else result, traces_interval_s)
         except Exception as exc:  # noqa: BLE001 - reported per run, the sweep goes on
             r = error_row(exc)
             failed += 1

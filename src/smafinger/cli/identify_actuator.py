@@ -233,7 +233,8 @@ def _outputs(setup: dict, result: dict, wall_s: float) -> tuple[list[tuple[Path,
            "offset_policy": setup["offset"], "files": ar.files_report(preds, p, figures),
            "summary": ar.role_summary(preds, p), "fit": fit.to_dict() if fit else None,
            "controller": None if setup["controller"] is None else vars(setup["controller"]),
-           "parameter_file": None if setup["out"] is None else str(setup["out"]), "wall_s": wall_s}
+           "parameter_file": None if setup["out"] is None else str(setup["out"]),
+           "step_notes": result["step_notes"], "wall_s": wall_s}
     outputs: list[tuple[Path, Callable[[str], None]]] = []
     if setup["out"] is not None:
         files = ", ".join(Path(r.file).name for r in setup["runs"] if r.role == "fit")

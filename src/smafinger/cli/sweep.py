@@ -82,7 +82,12 @@ def sweep(
                f"{report.failed_total} failed) in {report.wall_s:.1f} s on {report.backend}")
     if report.flagged_total:
         print(f"smafinger: {report.flagged_total} of {report.total} runs have warnings (physically absurd results, "
-              "or a target never pursued; see their warnings column)", file=sys.stderr)
+              "a target never pursued, or with check_step a step the run has not converged at; see their warnings "
+              "column)", file=sys.stderr)
+    if report.unchecked_total:
+        print(f"smafinger: {report.unchecked_total} of {report.total} runs were not step-checked: their rows were "
+              f"made before check_step was on, and were kept; delete {report.out} to check them",
+              file=sys.stderr)
     if report.failed_total:
         every = report.failed_total == report.total
         print(f"smafinger: {'every run' if every else f'{report.failed_total} of {report.total} runs'} failed "
