@@ -214,6 +214,28 @@ def test_a_stiff_slider_gets_a_shorter_reference_step(length_m, mass_kg, dt_s):
         assert np.sqrt(np.mean(err_mm ** 2)) < 0.05 and np.max(np.abs(err_mm)) < 0.6
 
 
+def test_a_heavily_damped_joint_gets_a_shorter_reference_step():
+    """The joint's damping mode, C_DF / I: at 3,074 1/s (paper2010 with whole-wire heating at
+    3.08 V, so the reference, and C_DF_heating 0.15) RK4 at 1 ms (lambda h 3.07, beyond its 2.785)
+    blew up at t = 2.696 s (found by a random search of the joint). The reference's step is now at
+    most lambda h = 2 (numerics.DAMPING_PER_STEP): 0.5 ms, and the run ends where RK4 at 0.1 ms does."""
+    from smafinger.engine.numerics import DAMPING_PER_STEP, damping_rate_per_s
+    from smafinger.engine.run import SimulationError
+
+    p = get("paper2010").replace(joule_heating="whole-wire", V_H_V=3.08, C_DF_heating_Nms=0.15)
+    kw = dict(strategy="cooperative", profile="0:-25,reach:-55", t_end_s=8.0)
+    assert damping_rate_per_s(p) * 1e-3 > 2.785 and damping_rate_per_s(get("paper2010")) * 1e-3 < DAMPING_PER_STEP
+    got = simulate(p, **kw)
+    assert _numerics(got.spec) == ("rk4", 5e-4, "exact") and reference_dt(get("paper2010")) == 1e-3
+    ref = simulate(p, **kw, dt_s=1e-4)
+    err = got.theta_deg - ref.theta_deg
+    assert np.sqrt(np.mean(err ** 2)) < 0.05 and np.max(np.abs(err)) < 0.3
+    with pytest.raises(SimulationError, match="numerical blow-up"):
+        simulate(p, **kw, dt_s=1e-3)
+    # damped beyond any step it shortens to (1 ms / 100): 1 ms, and a blow-up naming the parameter
+    assert reference_dt(get("paper2010-table2").replace(inertia_kg_m2=1e-9)) == 1e-3
+
+
 @pytest.mark.parametrize("method, dt_s", [("rk4", 1e-3), ("authors-ode4", 1e-3), ("euler", 1e-4), ("exponential", 1e-4)])
 def test_an_explicit_step_beyond_the_wire_slider_modes_stability_is_refused(method, dt_s):
     """rk4 at 1 ms on a 0.1 m wire pulling 5 g, or Euler or exponential Euler on the template at

@@ -198,16 +198,9 @@ def extreme_parameters(params) -> list[str]:
 
 
 
-def damping_rate_per_s(params) -> float:
-    """The mechanism's stiffest mode, its viscous damping over its inertia [1/s]: C_DF / I of
-    Eq. (2) for the joint (the larger of heating and cooling), c / m for the slider."""
-    if params.mechanism == "joint":
-        return max(params.C_DF_heating_Nms, params.C_DF_cooling_Nms) / params.inertia_kg_m2
-    return params.viscous_damping_N_s_m / params.slider_mass_kg
-
-
 def blowup_hint(spec) -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
+    from .engine.numerics import damping_rate_per_s
     from .engine.stability import REAL_AXIS
 
     limit = REAL_AXIS.get(spec.method)

@@ -282,6 +282,24 @@ def edge_step_refusal(params, controller, t_end_s: float) -> str | None:
 #: (:func:`reference_dt`): the template rig in austenite is 0.90 at 1 ms, where a drive cut
 #: while the wire transforms is within 0.003 mm of rk4 at 0.1 ms
 WIRE_MODE_RAD_PER_STEP = 1.0
+#: and at most this much of the damping's rate (lambda h, :func:`damping_rate_per_s`): RK4 is
+#: stable up to 2.785 (.stability.REAL_AXIS); the paper's cooling damping at 1 ms is 1.84, which
+#: the golden record and the convergence tests hold. A random search of the joint at the
+#: reference (whole-wire heating) blew up in 48 of 83 runs with lambda h above 2.785 at 1 ms and
+#: in none of 284 below it
+DAMPING_PER_STEP = 2.0
+#: the damping shortens the reference's step down to this [s] (1 ms / 100), no further: a set
+#: damped beyond it (200,000 1/s: 100 times the paper's) keeps 1 ms, and its blow-up names the
+#: extreme parameter (plausibility.blowup_hint) rather than running 10^8 steps in silence
+DAMPED_STEP_MIN_S = 1e-5
+
+
+def damping_rate_per_s(params) -> float:
+    """The mechanism's stiffest real mode, its viscous damping over its inertia [1/s]: C_DF / I of
+    Eq. (2) for the joint (the larger of heating and cooling), c / m for the slider."""
+    if params.mechanism == "joint":
+        return max(params.C_DF_heating_Nms, params.C_DF_cooling_Nms) / params.inertia_kg_m2
+    return params.viscous_damping_N_s_m / params.slider_mass_kg
 
 
 def wire_mode_omega(params) -> float | None:
@@ -297,29 +315,37 @@ def wire_mode_omega(params) -> float | None:
 
 
 def reference_dt(params) -> float:
-    """The reference's step [s]: 1 ms, or on a slider whose wire-slider mode turns more than
-    :data:`WIRE_MODE_RAD_PER_STEP` in 1 ms the longest 1 ms / n (n dividing 10^6, so that the
-    step is a whole number of nanoseconds) that does not. RK4 at 1 ms went unstable there and,
-    held by the end stops, returned a wrong trajectory: a 0.1 m wire pulling 5 g (5,700 rad/s)
-    was 19 mm RMS off rk4 at 10 us over a 1.8 mm stroke."""
-    omega = wire_mode_omega(params)
-    if omega is None or omega * DEFAULT_DT_S <= WIRE_MODE_RAD_PER_STEP:
-        return DEFAULT_DT_S
-    n = next((n for n in _DIVISORS_OF_1MS if omega * DEFAULT_DT_S / n <= WIRE_MODE_RAD_PER_STEP),
-             _DIVISORS_OF_1MS[-1])  # 1 ns at most: a mode beyond that is refused (unstable_step)
-    return DEFAULT_DT_S / n
+    """The reference's step [s]: 1 ms, or where a mode is too fast for RK4 at 1 ms the longest
+    1 ms / n (n dividing 10^6, so that the step is a whole number of nanoseconds) that holds it:
+    a slider's wire-slider mode turning at most :data:`WIRE_MODE_RAD_PER_STEP` a step (RK4 at 1 ms
+    went unstable there and, held by the end stops, returned a wrong trajectory: a 0.1 m wire
+    pulling 5 g, 5,700 rad/s, was 19 mm RMS off rk4 at 10 us over a 1.8 mm stroke), and the
+    damping at most :data:`DAMPING_PER_STEP`, down to :data:`DAMPED_STEP_MIN_S` (a joint with 5
+    times the paper's heating damping blew up at 1 ms)."""
+    omega = wire_mode_omega(params) or 0.0
+    rate = damping_rate_per_s(params)
+    if rate * DAMPED_STEP_MIN_S > DAMPING_PER_STEP:
+        rate = 0.0  # beyond any step this shortens to: 1 ms, and a blow-up that says why
+
+    def holds(h: float) -> bool:
+        return omega * h <= WIRE_MODE_RAD_PER_STEP and rate * h <= DAMPING_PER_STEP
+
+    # 1 ns at most: a mode beyond that is refused (unstable_step) or blows up with the step named
+    return DEFAULT_DT_S / next((n for n in _DIVISORS_OF_1MS if holds(DEFAULT_DT_S / n)), _DIVISORS_OF_1MS[-1])
 
 
-#: the fields the wire-slider mode's omega grows with (+1) or falls with (-1) (:func:`wire_mode_omega`)
-_OMEGA_FIELDS = {"D_A_Pa": 1, "wire_diameter_m": 1, "bias_spring_K_N_m": 1, "wire_length_m": -1, "slider_mass_kg": -1}
+#: the fields the modes :func:`reference_dt` holds grow with (+1) or fall with (-1): the
+#: wire-slider mode's omega (:func:`wire_mode_omega`) and the damping's rate (:func:`damping_rate_per_s`)
+_STIFFNESS_FIELDS = {"D_A_Pa": 1, "wire_diameter_m": 1, "bias_spring_K_N_m": 1, "wire_length_m": -1, "slider_mass_kg": -1,
+                     "viscous_damping_N_s_m": 1, "C_DF_heating_Nms": 1, "C_DF_cooling_Nms": 1, "inertia_kg_m2": -1}
 
 
 def reference_dt_within(params, bounds) -> float:
     """:func:`reference_dt` of the stiffest set within ``bounds`` (field name -> (lo, hi), the
     others as in ``params``): one step that holds every set a fit may try. A freed slider mass
     or wire had candidates beyond the start set's step, each refused and scored as a miss."""
-    stiffest = {name: bounds[name][1 if sign > 0 else 0] for name, sign in _OMEGA_FIELDS.items() if name in bounds}
-    return reference_dt(params.replace(**stiffest) if stiffest and params.mechanism != "joint" else params)
+    stiffest = {name: bounds[name][1 if sign > 0 else 0] for name, sign in _STIFFNESS_FIELDS.items() if name in bounds}
+    return reference_dt(params.replace(**stiffest) if stiffest else params)
 
 
 #: the divisors of 10^6 (1 ms in nanoseconds), ascending
