@@ -76,6 +76,9 @@ def test_a_light_undamped_rig_is_flagged_and_is_over_the_budget():
 def test_the_template_rig_is_within_the_budget_and_checked_by_default():
     p = get("linear-bias-spring")
     assert checked_by_default(p) and not checked_by_default(get("paper2010"))
+    assert checked_by_default(get("paper2010").replace(C_DF_heating_Nms=0.05))
+    assert not checked_by_default(get("paper2010").replace(C_DF_heating_Nms=0.05), validated=True)
+    assert checked_by_default(p.replace(slider_mass_kg=0.1), validated=True)  # a slider: always
     r = simulate(p, "open-loop", voltage="0:0.6,6:0,12:0.4,18:0", drive="duty", t_end_s=25.0, check_step=True)
     chk = r.step_check
     assert chk.within and 0 < chk.rms < chk.budget_rms and chk.signal == "position_m"
@@ -101,8 +104,11 @@ def test_simulate_command_checks_the_rig_by_default_and_the_joint_when_asked(tmp
     rig = ["simulate", "--params", "linear-bias-spring", "--strategy", "open-loop", "--duty", "0:0.6,3:0",
            "--t-end", "6", "--no-progress"]
     joint = ["simulate", "--profile", "0:-30", "--t-end", "2", "--no-progress"]
+    changed = joint + ["--set", "C_DF_heating_Nms=0.05"]  # a set no one validated the defaults on
+    scenario = ["simulate", "--scenario", "fig11-controller-off-v1", "--no-progress"]  # as registered
     for args, checked, signal in ((rig, True, "position_m"), (rig + ["--no-check-step"], False, None),
-                                  (joint, False, None), (joint + ["--check-step"], True, "theta_deg")):
+                                  (joint, False, None), (joint + ["--check-step"], True, "theta_deg"),
+                                  (changed, True, "theta_deg"), (scenario, False, None)):
         out = tmp_path / "s.json"
         assert main([*args, "--summary", str(out)]) == 0
         doc = json.loads(out.read_text())

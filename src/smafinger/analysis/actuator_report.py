@@ -30,7 +30,7 @@ import numpy as np
 
 from ..engine.batch import iter_batch
 from ..parameters import ParameterSet
-from ..step_check import StepCheck, compare, half_step
+from ..step_check import StepCheck, compare, half_step, samples_per_sample
 from .actuator_eval import coordinate_signal
 from .bench_runs import MIN_NOISE_SAMPLES, BenchRun, coordinate_column, output_si_name
 from .fit_uncertainty import lag1_autocorrelation
@@ -87,6 +87,12 @@ class RunPrediction:
                 "rms_offset_fitted": float(np.sqrt(np.mean(centred**2))), "lag1": lag1_autocorrelation(r)}
 
 
+def _signal_and_substeps(result, column: str) -> tuple[np.ndarray, int]:
+    """The batch workers' ``reduce`` of a run at half the step: its coordinate and its sub-step
+    count (the check's refinement, :mod:`smafinger.step_check`)."""
+    return coordinate_signal(result, column), int(result.substeps)
+
+
 def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets: dict[str, tuple[float, float]]
                  | None = None, policy: str = "per-run", dt_s: float = 1e-3) -> list[RunPrediction]:
     """Simulate every run with ``p`` (one batch) and set its offset (see the module docstring).
@@ -105,11 +111,11 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
             failed[k] = f"{type(exc).__name__}: {exc}"
     keys = list(specs)
     halves = {k: half_step(specs[k]) for k in keys}  # in the same batch: one pass over the pool
-    curves: dict[int, np.ndarray] = {}
-    checks: dict[int, np.ndarray] = {}
+    curves: dict[int, tuple[np.ndarray, int]] = {}
+    checks: dict[int, tuple[np.ndarray, int]] = {}
     check_failed: dict[int, str] = {}
     for j, ok, value in iter_batch([specs[k] for k in keys] + [halves[k] for k in keys], pool=pool,
-                                   reduce=partial(coordinate_signal, column=column), record="metrics"):
+                                   reduce=partial(_signal_and_substeps, column=column), record="metrics"):
         k = keys[j % len(keys)]
         if j < len(keys):
             if ok:
@@ -131,9 +137,13 @@ def predict_runs(runs: Sequence[BenchRun], p: ParameterSet, pool, fitted_offsets
         if k in failed:
             out.append(RunPrediction(run, offset, method, se, None, None, failed[k]))
             continue
-        y = curves[k]
+        y, substeps = curves[k]
         grid = np.round(np.arange(y.size) * run.output_interval_s, 9)
-        step = compare(specs[k], grid, y, checks[k], halves[k].dt_s) if k in checks else None
+        step = None
+        if k in checks:
+            y_check, check_substeps = checks[k]
+            step = compare(specs[k], grid, y, y_check[::samples_per_sample(specs[k], halves[k])], halves[k].dt_s,
+                           substeps, check_substeps)
         out.append(RunPrediction(run, offset, method, se, run.model_output(y, p), (grid, y / p.coordinate.scale),
                                  step=step, step_error=check_failed.get(k)))
     return out
@@ -151,7 +161,7 @@ def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bo
     ``fitted``: ``p`` is a fit's (whose values then absorb the error of the fitted runs among
     them)."""
     notes = []
-    over = [pr for pr in predictions if pr.step is not None and not pr.step.within]
+    over = [pr for pr in predictions if pr.step is not None and pr.step.within is False]
     if over:
         factor, unit, _ = DISPLAY[output_si_name(p)]
         shown = factor / p.coordinate.scale  # the check's user unit -> the display unit
@@ -172,6 +182,10 @@ def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bo
                      f"(dt_s = {c.dt_s:g}): its error, estimated at {c.factor:g}x its difference from the same run "
                      f"at half the step, is over the budget ({err(c.budget_rms)} RMS, {err(c.budget_max)} max) on "
                      f"{runs}{tail}")
+    unjudged = [pr for pr in predictions if pr.step is not None and not pr.step.judged]
+    if unjudged:
+        notes.append("the step check could not judge " + ", ".join(_label(pr) for pr in unjudged) + ": at half the "
+                     "step their sub-steps hardly shrank (the PWM edges and the output samples set them)")
     lost = [pr for pr in predictions if pr.step_error is not None]
     if lost:
         notes.append("the run at half the step failed, so the step was not checked, on "

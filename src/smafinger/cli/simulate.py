@@ -24,8 +24,8 @@ NUMERICS_HELP = (f"[default, with none of --dt/--method/--pwm given: a long step
                  f"open loop, pid, sliding-mode or rapid-heating): {LONG_STEP_METHOD}, {LONG_STEP_DT_S:g} s, "
                  f"{DEFAULT_PWM} (sub-steps at every PWM edge); "
                  f"otherwise, for --scenario, and for any of the three not given: {DEFAULT_METHOD}, "
-                 f"{DEFAULT_DT_S:g} s (on a slider whose wire-slider mode turns over 1 rad in that: 1 ms / n, "
-                 f"shorter), {DEFAULT_PWM}; docs/speed.md]")
+                 f"{DEFAULT_DT_S:g} s (1 ms / n, shorter, on a slider whose wire-slider mode turns over 1 rad in "
+                 f"that, or where the damping over the inertia is over 2,000 1/s), {DEFAULT_PWM}; docs/speed.md]")
 
 #: options that define the run (refused with --from; --scenario takes some of them)
 RUN_OPTIONS = ("params", "set_", "scenario", "strategy", "profile", "voltage", "duty", "current", "t_end", "dt",
@@ -58,7 +58,7 @@ def simulate(
     t_end: float = typer.Option(20.0, "--t-end", metavar="S", help="simulated time [s]"),
     dt: Optional[float] = typer.Option(None, "--dt", metavar="S", help="integration step [s] [default: see --method]"),
     method: Optional[Method] = typer.Option(None, "--method", help="integrator (authors-ode4: the authors' Simulink "
-                                                                   f"solver, fixed 1 ms (shorter on a stiff slider), PWM read at its stages) {NUMERICS_HELP}"),
+                                                                   f"solver, fixed 1 ms (shorter on a stiff slider or a heavily damped joint), PWM read at its stages) {NUMERICS_HELP}"),
     pwm: Optional[Pwm] = typer.Option(None, "--pwm", help="PWM drive: resolved at its edges (exact) or its period-"
                                                           "averaged power (averaged: long steps) [default: see --method]"),
     output_interval: float = typer.Option(DEFAULT_OUTPUT_S, "--output-interval", metavar="S", help="output sampling [s]"),
@@ -74,8 +74,9 @@ def simulate(
         None, "--check-step/--no-check-step",
         help="run it again at half the step and compare the position: warn if the error estimated from the "
              "difference (twice it) is over the accuracy budget the defaults were validated against (docs/cli.md) "
-             "[default: on for the linear rig, whose reference step is not validated on every rig; off for the "
-             "finger joint]"),
+             "[default: on for the linear rig, and for a finger-joint set changed from a named one (--set, a file) "
+             "outside a named scenario; off for the named joint sets and the scenarios, where the defaults were "
+             "validated]"),
     progress: Optional[bool] = progress_option(),
     engine: Optional[Engine] = typer.Option(
         None, "--engine", help="compiled: the numba kernel (compiled first if not cached); interpreted: the same "
@@ -146,8 +147,8 @@ def _check_choice(flag: Optional[bool], spec, extra: dict) -> bool:
         want = flag
     elif recorded in ("on", "off"):
         want = recorded == "on"
-    else:
-        want = checked_by_default(spec.params)
+    else:  # a named scenario as registered was validated (its set may differ from the named one)
+        want = checked_by_default(spec.params, validated="scenario" in extra and "scenario_changes" not in extra)
     why = uncheckable(spec) if want else None
     if why is not None and flag:
         raise UsageError(f"--check-step: {why}")

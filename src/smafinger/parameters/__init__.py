@@ -50,6 +50,11 @@ def changed_from_named(p: ParameterSet) -> tuple[str, ...]:
             + tuple(k for k, v in vars(p.options).items() if v != options[k]))
 
 
+def is_named(p: ParameterSet) -> bool:
+    """Whether ``p`` is a named set as registered (not changed with ``--set`` or in a file)."""
+    return p.name in REGISTRY and _named(p.name) == p
+
+
 @functools.cache
 def _named(name: str) -> ParameterSet:
     """A named set, built once (about 0.1 ms; a sweep's summary asks every run; sets are frozen)."""
@@ -80,5 +85,5 @@ def resolve(spec: str | Path | ParameterSet) -> ParameterSet:
 
 
 __all__ = ["ParameterError", "ParameterSet", "JointParameters", "LinearActuatorParameters", "ModelOptions",
-           "MECHANISMS", "get", "names", "changed_from_named", "resolve", "load_toml", "from_dict", "field_spec",
+           "MECHANISMS", "get", "names", "changed_from_named", "is_named", "resolve", "load_toml", "from_dict", "field_spec",
            "parse_value", "REGISTRY"]
