@@ -262,3 +262,20 @@ def test_identify_actuator_names_why_a_runs_check_failed(tmp_path, monkeypatch):
     (note,) = ar.step_notes([pr], p, fitted=False)
     assert "a.csv (validate): ValueError" in note and "longer than t_end_s" in note
     assert ar.files_report([pr], p)[0]["step_check"] == {"error": pr.step_error}
+
+
+def test_a_pwm_far_faster_than_the_step_is_not_judged():
+    """A 10 kHz PWM on the template rig: its edges set the sub-steps whatever the step (66,000 of
+    them at half the step against 63,000), so the estimate would be 21x a difference that says
+    little: the check does not judge, says so in its line, and warns of nothing."""
+    from smafinger.step_check import MIN_REFINEMENT
+
+    p = get("linear-bias-spring")
+    kw = dict(voltage="0:0.6,3:0", drive="duty", t_end_s=6.0, check_step=True)
+    fast = simulate(p.replace(pwm_period_s=1e-4), "open-loop", **kw)
+    chk = fast.step_check
+    assert chk.refinement < MIN_REFINEMENT and not chk.judged and chk.within is None
+    assert "not judged" in chk.describe() and math.isnan(chk.estimated_rms) and fast.metrics["warnings"] == []
+    assert chk.to_dict()["judged"] is False
+    slow = simulate(p, "open-loop", **kw).step_check  # the template's 1 kHz: judged
+    assert slow.judged and slow.refinement > 1.5 and slow.within

@@ -179,7 +179,7 @@ def step_notes(predictions: Sequence[RunPrediction], p: ParameterSet, fitted: bo
             tail += ("; a closed loop can amplify differences below any step's error, so a replay's error is "
                      "one run's, not converged (docs/speed.md)")
         notes.append(f"the model at this set has not converged at the {'fit' if fitted else 'run'}'s step "
-                     f"(dt_s = {c.dt_s:g}): its error, estimated at {c.factor:g}x its difference from the same run "
+                     f"(dt_s = {c.dt_s:g}): its error, estimated at {c.factor:.3g}x its difference from the same run "
                      f"at half the step, is over the budget ({err(c.budget_rms)} RMS, {err(c.budget_max)} max) on "
                      f"{runs}{tail}")
     unjudged = [pr for pr in predictions if pr.step is not None and not pr.step.judged]
