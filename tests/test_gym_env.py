@@ -63,6 +63,14 @@ def test_bad_session_settings_name_the_field_and_value(kwargs, match):
         PlantSession("paper2010", **kwargs)
 
 
+def test_a_joint_too_damped_for_the_plants_step_is_refused_when_made():
+    """5x paper2010's damping (3,074 1/s) blew up RK4 at 1 ms mid-episode with no hint (found by
+    review): refused when made, naming the damping and the step it holds."""
+    with pytest.raises(ValueError, match=r"this set's damping \(3074 1/s\) holds rk4 only up to dt = 0.91 ms"):
+        PlantSession("paper2010", overrides=("C_DF_heating_Nms=0.15", "C_DF_cooling_Nms=0.15"))
+    assert PlantSession("paper2010", overrides=("C_DF_heating_Nms=0.12",))  # 2,459 1/s: held at 1 ms
+
+
 def test_a_slider_too_stiff_for_the_plants_step_is_refused_when_made():
     """A 0.1 m wire pulling 5 g: its wire-slider mode makes the plant's RK4 at 1 ms unstable
     (engine.numerics.unstable_step). It was accepted and refused at reset() (found by review)."""

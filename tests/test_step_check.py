@@ -279,3 +279,41 @@ def test_a_pwm_far_faster_than_the_step_is_not_judged():
     assert chk.to_dict()["judged"] is False
     slow = simulate(p, "open-loop", **kw).step_check  # the template's 1 kHz: judged
     assert slow.judged and slow.refinement > 1.5 and slow.within
+
+
+def test_the_check_keeps_the_runs_output_interval_where_twice_the_samples_are_over_the_memory_limit(monkeypatch):
+    """Halving the output interval doubles the samples: a run just within the memory limit made
+    its check raise an internal error after the run (found by review); it now keeps the run's interval."""
+    import smafinger.engine.run as engine_run
+
+    r = simulate("linear-bias-spring", "open-loop", voltage="0:0.6,3:0", drive="duty", t_end_s=6.0)
+    monkeypatch.setattr(engine_run, "memory_limit_bytes", lambda: 2 * 8 * 9000 * 21)  # 6,001 samples pass, 12,001 not
+    chk = with_step_check(r).step_check
+    assert chk.check_dt_s == 5e-4 and chk.judged and chk.within
+
+
+def test_a_sweep_row_the_check_did_not_judge_is_checked_not_unchecked(tmp_path):
+    """A 10 kHz PWM row: checked, not judged (NaN errors, its refinement recorded); it was counted
+    as a row made before check_step was on (found by review)."""
+    import pandas as pd
+
+    from smafinger.analysis.sweep import parse_spec, run_sweep
+
+    data = {"base": {"params": "linear-bias-spring", "strategy": "open-loop", "voltage": "0:0.6,3:0", "drive": "duty",
+                     "t_end_s": 6.0}, "vary": {"pwm_period_s": {"values": [1e-3, 1e-4]}}, "sweep": {"check_step": True}}
+    rep = run_sweep(parse_spec(data), tmp_path / "s.parquet", workers=1)
+    df = pd.read_parquet(tmp_path / "s.parquet").sort_values("point")
+    assert rep.unchecked_total == 0 and df["step_refinement"].notna().all()
+    assert df["step_error_rms_m"].notna().tolist() == [True, False] and df["step_refinement"].iloc[1] < 1.05
+
+
+def test_identify_joint_warns_when_the_fitted_damping_is_at_its_steps_stability_limit():
+    """The joint fit runs every candidate at RK4, 1 ms: beyond C_DF / I = 2,785 1/s candidates blew
+    up and were scored as misses, so curves made with C_DF_cooling 0.2 were fitted to 0.1355
+    +- 9e-8 with no warning (found by review). A fitted damping at 90 % of that limit or more is warned."""
+    from smafinger.analysis.joint_phase import _stability_warnings
+
+    p = get("paper2010")
+    assert _stability_warnings("cooling", p) == []  # 1,844 1/s: 66 % of the limit
+    (w,) = _stability_warnings("cooling", p.replace(C_DF_cooling_Nms=0.1355))
+    assert w.startswith("cooling: the fitted damping (C_DF / I = 2777 1/s) is at 100% of what rk4 holds")

@@ -200,14 +200,13 @@ def extreme_parameters(params) -> list[str]:
 
 def blowup_hint(spec) -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
-    from .engine.numerics import damping_rate_per_s
-    from .engine.stability import REAL_AXIS
+    from .engine.numerics import damping_rate_per_s, damping_step_limit
 
-    limit = REAL_AXIS.get(spec.method)
-    rate = damping_rate_per_s(spec.params)
-    if limit is not None and rate * spec.dt_s > limit:
-        hint = (f"{spec.method} is stable only up to dt = {limit / rate * 1e3:.2g} ms against this set's damping "
-                f"({rate:.4g} 1/s; now {spec.dt_s * 1e3:g} ms): use a smaller --dt or --method exponential")
+    limit = damping_step_limit(spec.params, spec.method)
+    if limit is not None and spec.dt_s > limit:
+        hint = (f"{spec.method} is stable only up to dt = {limit * 1e3:.2g} ms against this set's damping "
+                f"({damping_rate_per_s(spec.params):.4g} 1/s; now {spec.dt_s * 1e3:g} ms): use a smaller --dt or "
+                "--method exponential")
     else:
         hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
         if spec.method != "rk4":

@@ -99,7 +99,7 @@ class StepCheck:
 
     def _against(self) -> str:
         return (f"against the same run at dt_s = {self.check_dt_s:g} ({self.check_substeps} sub-steps, "
-                f"{self.refinement:.3g}x this run's {self.substeps})")
+                f"{self.refinement:.4g}x this run's {self.substeps})")
 
     def describe(self) -> str:
         """One line: the difference, the estimate and the budget."""
@@ -192,7 +192,11 @@ def check_step(result, engine: str = "compiled", progress=False, remedy: str = R
     spec = result.spec
     half = half_step(spec)
     try:
-        other = run_spec(half, progress=progress, engine=engine, record="metrics")
+        try:
+            other = run_spec(half, progress=progress, engine=engine, record="metrics")
+        except ValueError:  # twice the samples over the memory limit (found by review): the run's interval
+            half = half_step(spec, halve_output=False)
+            other = run_spec(half, progress=progress, engine=engine, record="metrics")
     except SimulationError as exc:  # the same class (DutyNotANumber stays one)
         raise type(exc)(f"step check: the run at dt_s = {spec.dt_s:g} finished, the same run at dt_s = "
                         f"{half.dt_s:g} stopped ({remedy}): {exc}") from None
@@ -213,11 +217,11 @@ def uncheckable(spec) -> str | None:
     return None
 
 
-def half_step(spec):
+def half_step(spec, halve_output: bool = True):
     """``spec`` (a :class:`~smafinger.engine.run.RunSpec`) at half its step, to the clock's tick
-    below, and at half its output interval where that is a whole number of ticks (with the PWM
-    resolved, a sub-step ends at every output sample); ValueError where :func:`uncheckable` says
-    why not."""
+    below, and (``halve_output``) at half its output interval where that is a whole number of
+    ticks (with the PWM resolved, a sub-step ends at every output sample); ValueError where
+    :func:`uncheckable` says why not."""
     from .engine.clock import TICK_S, to_ticks
 
     why = uncheckable(spec)
@@ -225,7 +229,7 @@ def half_step(spec):
         raise ValueError(why)
     out = to_ticks("output_interval_s", spec.output_interval_s)
     return dataclasses.replace(spec, dt_s=(to_ticks("dt_s", spec.dt_s) // 2) * TICK_S,
-                               output_interval_s=(out // 2 if out % 2 == 0 else out) * TICK_S)
+                               output_interval_s=(out // 2 if out % 2 == 0 and halve_output else out) * TICK_S)
 
 
 def samples_per_sample(spec, half) -> int:

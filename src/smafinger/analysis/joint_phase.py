@@ -90,8 +90,29 @@ def fit_phase(phase: str, experiments: Sequence[tuple[AngleCurve, VoltageProgram
         rms_deg=math.sqrt(float(r @ r) / r.size), rms_start_deg=rms_start,
         curves=_per_curve(experiments, r), nfev=obj.nfev, wall_s=time.perf_counter() - t0,
         scan_factor=best_k, success=success, message=f"{message} ({runs} least-squares run(s))",
-        warnings=_identifiability_warnings(phase, fields, corr, sd) + _bound_warnings(phase, obj, z, values),
+        warnings=(_identifiability_warnings(phase, fields, corr, sd) + _bound_warnings(phase, obj, z, values)
+                  + _stability_warnings(phase, obj.params(z))),
     )
+
+
+#: the share of RK4's stable step against the damping beyond which a fitted set is at the wall
+#: (:func:`_stability_warnings`)
+NEAR_STABILITY = 0.9
+
+
+def _stability_warnings(phase: str, p: ParameterSet) -> list[str]:
+    """A fitted damping near what RK4 holds at the fit's step (:data:`.joint_experiments.FIT_DT_S`):
+    candidates beyond it blew up and were scored as misses, a wall the fit can stop at. Found by
+    review: curves made with C_DF_cooling 0.2 were fitted to 0.1355 +- 9e-8, the wall at 1 ms."""
+    from ..engine.numerics import damping_rate_per_s, damping_step_limit
+    from .joint_experiments import FIT_DT_S, FIT_METHOD
+
+    limit = damping_step_limit(p, FIT_METHOD)
+    if limit is None or FIT_DT_S < NEAR_STABILITY * limit:
+        return []
+    return [f"{phase}: the fitted damping (C_DF / I = {damping_rate_per_s(p):.4g} 1/s) is at "
+            f"{FIT_DT_S / limit:.0%} of what {FIT_METHOD} holds at the fit's {FIT_DT_S * 1e3:g} ms step: candidates "
+            "beyond it blew up and were scored as misses, so the value may be that limit's, not the curves'"]
 
 
 #: a fitted log-value this close to an end of its search range is at the bound

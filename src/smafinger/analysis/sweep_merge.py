@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, STEP_COLUMNS, STRING_COLUMNS, TRACE_COLUMNS
+from .sweep_rows import INT_COLUMNS, METRIC_COLUMNS, SEGMENT_COLUMNS, STEP_REFINEMENT, STRING_COLUMNS, TRACE_COLUMNS
 from ..files import atomic_write
 from .sweep_store import (META_KEY, TABLE_BLOCK, TRACE_BLOCK_SAMPLES, IdIndex, StoreError, _ids, read_meta,
                           traces_interval, traces_path)
@@ -184,8 +184,8 @@ class Finished:
         return self._count("warnings", lambda w: np.array([bool(x) for x in w], dtype=bool))
 
     def unchecked_count(self) -> int:
-        """Finished ``ok`` rows with no step check (every :data:`.sweep_rows.STEP_COLUMNS` NaN, or
-        a row written before those columns existed)."""
+        """Finished ``ok`` rows with no step check (:data:`.sweep_rows.STEP_REFINEMENT` NaN, or a
+        row written before that column existed); a check that did not judge has its refinement."""
         n = 0
         for s, src in enumerate(self.sources):
             sel = np.flatnonzero(self.src == s)
@@ -194,8 +194,8 @@ class Finished:
             rows = src.take(self.row[sel])
             ok = rows["status"].to_numpy(zero_copy_only=False) == "ok"
             checked = np.zeros(ok.size, dtype=bool)
-            for c in (c for c in STEP_COLUMNS if c in src.names):
-                checked |= ~np.isnan(rows[c].to_numpy(zero_copy_only=False).astype(np.float64))
+            if STEP_REFINEMENT in src.names:
+                checked = ~np.isnan(rows[STEP_REFINEMENT].to_numpy(zero_copy_only=False).astype(np.float64))
             n += int(np.sum(ok & ~checked))
             src.release()
         return n

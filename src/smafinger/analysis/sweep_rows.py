@@ -53,6 +53,9 @@ UNITS = _unique(unit for _, unit in COORDINATES)
 #: with [sweep] check_step: the coordinate's error estimated from the same run at half the step
 #: (smafinger.step_check: twice the difference), RMS and largest, in each unit; NaN without
 STEP_COLUMNS = tuple(f"step_error_{stat}_{u}" for u in UNITS for stat in ("rms", "max"))
+#: with [sweep] check_step: the ratio of the two runs' sub-step counts (below the check's
+#: MIN_REFINEMENT it does not judge, and the errors are NaN); NaN where the run was not checked
+STEP_REFINEMENT = "step_refinement"
 #: what a sweep's failed step check advises (its row's error)
 SWEEP_CHECK_REMEDY = "remove check_step from [sweep] to skip the check"
 #: per-run metric columns, in table order (then the per-segment ``seg{i}_*`` columns)
@@ -67,7 +70,7 @@ METRIC_COLUMNS = (
     # the run's warnings (its metrics': physically absurd results, smafinger.plausibility; a target never
     # pursued; with [sweep] check_step, a step the run has not converged at), "; "-joined
     "warnings",
-    *STEP_COLUMNS,
+    *STEP_COLUMNS, STEP_REFINEMENT,
 )
 INT_COLUMNS = ("interlock_violations", "steps")
 #: text columns (the others are numbers)
@@ -102,11 +105,12 @@ def metrics_row(result, traces_interval_s: float | None = None) -> dict:
         "steps": int(s["steps"]), "wall_s": float(s["wall_s"]),
         "run_method": result.spec.method, "run_dt_s": float(result.spec.dt_s), "run_pwm": result.spec.pwm,
         "warnings": WARNINGS_SEPARATOR.join(s["warnings"]),
-        **dict.fromkeys(STEP_COLUMNS, math.nan),
+        **dict.fromkeys((*STEP_COLUMNS, STEP_REFINEMENT), math.nan),
     })
     chk = result.step_check
     if chk is not None:
         row[f"step_error_rms_{unit}"], row[f"step_error_max_{unit}"] = chk.estimated_rms, chk.estimated_max
+        row[STEP_REFINEMENT] = chk.refinement
     segs = {seg["index"]: seg for seg in s["segments"]}
     for i, seg_def in enumerate(result.spec.profile.segments):
         seg = segs.get(i)

@@ -49,11 +49,16 @@ class PlantSession:
             raise ValueError(f"overrides = {overrides!r} must be a list of NAME=VALUE strings")
         p = get_params(params) if isinstance(params, str) else params
         self.params = p.with_overrides(list(overrides)) if overrides else p
-        from ..engine.numerics import unstable_step
+        from ..engine.numerics import damping_rate_per_s, damping_step_limit, unstable_step
 
-        if (why := unstable_step(self.params, BENCH_NUMERICS["method"], BENCH_NUMERICS["dt_s"])) is not None:
+        method, step = BENCH_NUMERICS["method"], BENCH_NUMERICS["dt_s"]
+        why = unstable_step(self.params, method, step)
+        if why is None and (limit := damping_step_limit(self.params, method)) is not None and step > limit:
+            why = (f"this set's damping ({damping_rate_per_s(self.params):.4g} 1/s) holds {method} only up to "
+                   f"dt = {limit * 1e3:.2g} ms: it would blow up")  # found by review: mid-episode, with no hint
+        if why is not None:
             raise ValueError(f"params {self.params.name} with overrides {list(overrides)}: the plant runs at "
-                             f"{BENCH_NUMERICS['method']}, {BENCH_NUMERICS['dt_s']:g} s (not settable here): {why}")
+                             f"{method}, {step:g} s (not settable here): {why}")
         self.dt = _positive("control_interval_s", control_interval_s)
         if self.dt < BENCH_NUMERICS["dt_s"]:
             raise ValueError(f"control_interval_s = {control_interval_s!r} is shorter than the plant's step, "

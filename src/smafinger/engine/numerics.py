@@ -38,7 +38,7 @@ import numpy as np
 from ..parameters.options import Hysteresis, JouleHeating, StressLaw
 from .defaults import (DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM, LONG_STEP_DT_S, LONG_STEP_METHOD,
                        LONG_STEP_PWM, LONG_STEP_STIFF_METHOD)
-from .stability import UNDAMPED
+from .stability import REAL_AXIS, UNDAMPED
 
 #: the long step needs at least this many steps across the transformation band (A_S0 to A_F0)
 #: at the run's strongest drive (:func:`_fast_transformation`). Measured on the linear rig in
@@ -312,6 +312,14 @@ def wire_mode_omega(params) -> float | None:
         return None
     area = math.pi * params.wire_diameter_m ** 2 / 4.0
     return math.sqrt((params.D_A_Pa * area / params.wire_length_m + params.bias_spring_K_N_m) / params.slider_mass_kg)
+
+
+def damping_step_limit(params, method: str) -> float | None:
+    """The longest step [s] an explicit ``method`` holds against the damping's rate
+    (:func:`damping_rate_per_s`, by :data:`.stability.REAL_AXIS`); None for a method exact in the
+    damping (exponential, semi-implicit) or a set with none."""
+    bound, rate = REAL_AXIS.get(method), damping_rate_per_s(params)
+    return None if bound is None or rate <= 0.0 else bound / rate
 
 
 def reference_dt(params) -> float:
