@@ -317,3 +317,18 @@ def test_identify_joint_warns_when_the_fitted_damping_is_at_its_steps_stability_
     assert _stability_warnings("cooling", p) == []  # 1,844 1/s: 66 % of the limit
     (w,) = _stability_warnings("cooling", p.replace(C_DF_cooling_Nms=0.1355))
     assert w.startswith("cooling: the fitted damping (C_DF / I = 2777 1/s) is at 100% of what rk4 holds")
+
+
+def test_a_sweep_rows_blow_up_says_what_to_change(tmp_path):
+    """A point damped beyond what RK4 at its step holds blows up: its error says which parameter
+    and which step, as simulate's does (the sweep's error column had only the state; found by review)."""
+    import pandas as pd
+
+    from smafinger.analysis.sweep import parse_spec, run_sweep
+
+    data = {"base": {"params": "paper2010-table2", "strategy": "open-loop", "voltage": "0:8:0", "t_end_s": 8.0,
+                     "method": "euler"}, "vary": {"inertia_kg_m2": {"values": [4.88e-5, 1e-9]}}}
+    run_sweep(parse_spec(data), tmp_path / "s.parquet", workers=1)
+    df = pd.read_parquet(tmp_path / "s.parquet").sort_values("point")
+    assert df["status"].tolist() == ["ok", "error"]
+    assert "numerical blow-up" in df["error"].iloc[1] and "check inertia_kg_m2 = 1e-09" in df["error"].iloc[1]

@@ -21,7 +21,7 @@ sub-steps hardly shrank (r below :data:`MIN_REFINEMENT`, a PWM period far below 
 judged: its line says so, with no warning.
 
 What it cannot see: an error that does not shrink from the step to its half (a random search of
-the linear rig: 4 of 67 open-loop runs over the budget were not flagged; of the finger joint's
+the linear rig: 3 of 67 open-loop runs over the budget were not flagged; of the finger joint's
 long step, a reach time late by the same tens of milliseconds at 5 and 2.5 ms; docs/speed.md),
 and the error of a model choice the step leaves as it is (the averaged PWM against the exact
 edges).
