@@ -108,7 +108,9 @@ def test_simulate_command_checks_the_rig_by_default_and_the_joint_when_asked(tmp
     scenario = ["simulate", "--scenario", "fig11-controller-off-v1", "--no-progress"]  # as registered
     for args, checked, signal in ((rig, True, "position_m"), (rig + ["--no-check-step"], False, None),
                                   (joint, False, None), (joint + ["--check-step"], True, "theta_deg"),
-                                  (changed, True, "theta_deg"), (scenario, False, None)):
+                                  (changed, True, "theta_deg"), (scenario, False, None),
+                                  (scenario + ["--dt", "0.001"], False, None),  # its own numerics, repeated
+                                  (scenario + ["--set", "C_DF_heating_Nms=0.05"], True, "theta_deg")):
         out = tmp_path / "s.json"
         assert main([*args, "--summary", str(out)]) == 0
         doc = json.loads(out.read_text())
