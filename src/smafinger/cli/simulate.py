@@ -73,7 +73,8 @@ def simulate(
     check_step: Optional[bool] = typer.Option(
         None, "--check-step/--no-check-step",
         help="run it again at half the step and compare the position: warn if the error estimated from the "
-             "difference (twice it) is over the accuracy budget the defaults were validated against (docs/cli.md) "
+             "difference (about twice it) is over the accuracy budget the defaults were validated against "
+             "(docs/cli.md) "
              "[default: on for the linear rig, and for a finger-joint set changed from a named one (--set, a file) "
              "outside a named scenario; off for the named joint sets and the scenarios, where the defaults were "
              "validated]"),

@@ -383,7 +383,8 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     check_step : bool
         Run it again at half the step and compare (:mod:`smafinger.step_check`): the result's
         ``step_check``, and a warning among its metrics' if the error estimated from the
-        difference is over the budget. ``smafinger simulate`` does this by default on a slider.
+        difference is over the budget. ``smafinger simulate`` does this by default on a slider
+        and on a finger-joint set changed from a named one (docs/cli.md, "The step check").
         Under ``engine="auto"`` the check runs on the engine the run used.
 
     Returns
