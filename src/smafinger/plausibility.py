@@ -198,6 +198,19 @@ def extreme_parameters(params) -> list[str]:
 
 
 
+def hinted(spec, run):
+    """``run()`` (a run of ``spec``), a numerical blow-up's message saying what to change
+    (:func:`blowup_hint`); a duty that is not a number as it is (the step is not what to change)."""
+    from .engine.run import DutyNotANumber, SimulationError
+
+    try:
+        return run()
+    except DutyNotANumber:
+        raise
+    except SimulationError as exc:
+        raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
+
+
 def blowup_hint(spec) -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
     from .engine.numerics import damping_rate_per_s, damping_step_limit

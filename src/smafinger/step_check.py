@@ -238,17 +238,19 @@ def samples_per_sample(spec, half) -> int:
     return round(spec.output_interval_s / half.output_interval_s)
 
 
-def check_engine(result, setting: str) -> str | None:
+def check_engine(result, setting: str, skip_long: bool = True) -> str | None:
     """The engine of ``result``'s run at half the step under the engine ``setting``: the one
     ``result`` ran on if ``setting`` is ``auto`` (so that the check never compiles in the
-    foreground after a run interpreted while the kernel compiles); None where that run would be
-    interpreted and is estimated over :data:`.engine.interpreted.INTERPRETED_LIMIT_S` (not checked
-    then: run it again once the kernel is compiled)."""
+    foreground after a run interpreted while the kernel compiles); with ``skip_long``, None where
+    that run would be interpreted and is estimated over
+    :data:`.engine.interpreted.INTERPRETED_LIMIT_S` (not checked then: run it again once the
+    kernel is compiled)."""
     from .engine.interpreted import INTERPRETED_LIMIT_S, interpreted_estimate_s
 
     if setting != "auto":
         return setting
-    if result.engine == "interpreted" and interpreted_estimate_s(half_step(result.spec)) > INTERPRETED_LIMIT_S:
+    if (skip_long and result.engine == "interpreted"
+            and interpreted_estimate_s(half_step(result.spec)) > INTERPRETED_LIMIT_S):
         return None
     return result.engine
 

@@ -25,6 +25,7 @@ from ..engine.batch import FLOAT64_SIGNALS, warm_up
 from ..engine.run import run_spec
 from ..engine.signals import COORDINATE_NAMES
 from ..parameters import MECHANISMS
+from ..plausibility import hinted
 from ..step_check import half_step, with_step_check
 from .sweep_spec import SPEC_ERRORS, SweepTemplate, run_id
 
@@ -236,7 +237,8 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
             if run_id(spec) != rid:
                 raise RuntimeError(f"internal error: point {point} was checked as run {rid} but builds "
                                    f"run {run_id(spec)}")
-            result = _run(spec, "all" if traces_interval_s else "metrics")
+            record = "all" if traces_interval_s else "metrics"
+            result = hinted(spec, lambda: run_spec(spec, record=record))
             r = row(with_step_check(result, remedy=SWEEP_CHECK_REMEDY) if check_step else result, traces_interval_s)
         except Exception as exc:  # noqa: BLE001 - reported per run, the sweep goes on
             r = error_row(exc)
@@ -246,20 +248,6 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
             traces.append((rid, point, tr))
         rows.append({"run_id": rid, "point": int(point), **r})
     return RowBlock(rows, _trace_columns(traces) if traces_interval_s else None, failed)
-
-
-def _run(spec, record: str):
-    """``run_spec``, a blow-up's message saying what to change, as ``smafinger simulate``'s does
-    (:func:`smafinger.plausibility.blowup_hint`; a sweep's error column had only the state)."""
-    from ..engine.run import DutyNotANumber, SimulationError
-    from ..plausibility import blowup_hint
-
-    try:
-        return run_spec(spec, record=record)
-    except DutyNotANumber:  # the step is not what to change
-        raise
-    except SimulationError as exc:
-        raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
 
 
 def _trace_columns(traces: list[tuple[str, int, dict]]) -> dict:

@@ -86,11 +86,10 @@ def simulate(
 ):
     """Simulate an SMA actuator (the finger joint or a linear bias-spring rig) and report the metrics."""
     from ..engine.interpreted import engine_setting
-    from ..engine.run import DutyNotANumber, SimulationError, run_spec
+    from ..engine.run import run_spec
     from ..export import add_plot, add_signals, add_summary
     from ..files import Outputs
-    from ..plausibility import blowup_hint
-    from ..step_check import check_engine, with_step_check
+    from ..plausibility import hinted
 
     _check_outputs(out, summary, plot)
     try:
@@ -101,20 +100,9 @@ def simulate(
                         method, pwm, output_interval, tol_deg, tol_m, hold_s)
     checking = _check_choice(check_step, spec, extra)
     with progress_display(progress) as display:
-        try:
-            result = run_spec(spec, progress=display, engine=setting)
-        except DutyNotANumber:  # the step is not what to change
-            raise
-        except SimulationError as exc:
-            raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
+        result = hinted(spec, lambda: run_spec(spec, progress=display, engine=setting))
         if checking:  # its failure says it is the check's (a shorter step is no advice there)
-            check_with = check_engine(result, setting)
-            if check_with is None:
-                print("smafinger: note: the step was not checked: this run was interpreted while the kernel "
-                      "compiles, and the same run at half the step would take long interpreted; run it again "
-                      "once the kernel is compiled", file=sys.stderr)
-            else:
-                result = with_step_check(result, check_with, progress=display)
+            result = _step_checked(result, setting, display)
     outputs = Outputs()
     if out is not None:
         add_signals(outputs, result, out, "--out", **extra)
@@ -133,6 +121,20 @@ def simulate(
               "kernel, equal to rounding)" + ("" if setting != "auto" or INTERPRETED else
                                              ": the compiled kernel was not in numba's cache, and is being compiled "
                                              "in the background for the runs that follow"), file=sys.stderr)
+
+
+def _step_checked(result, setting: str, display):
+    """``result`` with its step check on the engine :func:`~smafinger.step_check.check_engine`
+    chooses, or as it is, with a note, where that would take long interpreted."""
+    from ..step_check import check_engine, with_step_check
+
+    check_with = check_engine(result, setting)
+    if check_with is not None:
+        return with_step_check(result, check_with, progress=display)
+    print("smafinger: note: the step was not checked: this run was interpreted while the kernel compiles, and the "
+          "same run at half the step would take long interpreted; run it again once the kernel is compiled",
+          file=sys.stderr)
+    return result
 
 
 def _check_choice(flag: Optional[bool], spec, extra: dict) -> bool:

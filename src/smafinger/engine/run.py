@@ -409,8 +409,8 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
         half_step(spec)  # a step with no shorter one is refused before the run
     setting = interpreted.engine_setting(engine)
     result = run_spec(spec, progress=progress, engine=setting)
-    if check_step:
-        from ..step_check import with_step_check
+    if check_step:  # asked for: made, however long interpreted
+        from ..step_check import check_engine, with_step_check
 
-        result = with_step_check(result, result.engine if setting == "auto" else setting)
+        result = with_step_check(result, check_engine(result, setting, skip_long=False))
     return result
