@@ -94,10 +94,10 @@ def test_deterministic_and_decimated():
 
 
 def test_a_one_tick_step_has_no_half():
-    spec = make_spec("paper2010", "cooperative", "0:-30", t_end_s=1.0)
-    fake = types.SimpleNamespace(spec=spec.__class__(**{**spec.__dict__, "dt_s": 1e-9}))
+    spec = make_spec("paper2010", "cooperative", "0:-30", t_end_s=1e-6, dt_s=1e-9, output_interval_s=1e-7,
+                     method="rk4", pwm="exact")
     with pytest.raises(ValueError, match="dt_s = 1e-09 s is the clock's tick"):
-        check_step(fake)
+        check_step(run_spec(spec))
 
 
 def test_simulate_command_checks_the_rig_by_default_and_the_joint_when_asked(tmp_path, capsys):
@@ -334,3 +334,15 @@ def test_a_sweep_rows_blow_up_says_what_to_change(tmp_path):
     df = pd.read_parquet(tmp_path / "s.parquet").sort_values("point")
     assert df["status"].tolist() == ["ok", "error"]
     assert "numerical blow-up" in df["error"].iloc[1] and "check inertia_kg_m2 = 1e-09" in df["error"].iloc[1]
+
+
+def test_a_compact_batch_result_is_refused_by_name():
+    """A batch's CompactResult keeps decimated float32 signals and no sub-step count: the check
+    refuses it with a TypeError naming its type (it raised AttributeError on a missing field)."""
+    from smafinger.engine.batch import Compact
+
+    spec = make_spec("linear-bias-spring", "open-loop", voltage="0:0.5,1:0", t_end_s=2.0)
+    compact = Compact(every=10)(run_spec(spec))
+    for call in (check_step, with_step_check):
+        with pytest.raises(TypeError, match="CompactResult"):
+            call(compact)

@@ -182,13 +182,21 @@ def check_step(result, engine: str = "compiled", progress=False, remedy: str = R
 
     Raises
     ------
+    TypeError
+        ``result`` is not a :class:`~smafinger.results.SimulationResult` (a batch's
+        :class:`~smafinger.engine.batch.CompactResult` keeps too little of the run).
     ValueError
         The run's step is one clock tick (1 ns): it has no half.
     SimulationError
         The run at half the step stopped (its message says so).
     """
     from .engine.run import SimulationError, run_spec
+    from .results import SimulationResult
 
+    if not isinstance(result, SimulationResult):
+        raise TypeError(f"the step check needs a SimulationResult, not a {type(result).__name__}: it reads the "
+                        "run's own samples and sub-step count (for a batch's run, check "
+                        "smafinger.engine.run.run_spec(result.spec), or give a sweep check_step = true)")
     spec = result.spec
     half = half_step(spec)
     try:
