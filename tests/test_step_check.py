@@ -346,3 +346,22 @@ def test_a_compact_batch_result_is_refused_by_name():
     for call in (check_step, with_step_check):
         with pytest.raises(TypeError, match="CompactResult"):
             call(compact)
+
+
+def test_a_batch_checks_its_runs_in_the_workers_when_asked():
+    """Compact(check_step=True) checks each run where it ran: the compact summary holds the same
+    check as the run checked alone, and the warning with it."""
+    from smafinger.engine.batch import Compact, run_batch
+
+    light = get("linear-bias-spring").replace(**LIGHT_RIG)
+    specs = [make_spec(light, **LIGHT_RIG_RUN), make_spec("paper2010", "cooperative", "0:-30", t_end_s=2.0)]
+    out = run_batch(specs, workers=1, reduce=Compact(every=10, check_step=True))
+    for spec, compact in zip(specs, out):
+        alone = with_step_check(run_spec(spec))
+        assert compact.summary["step_check"] == alone.summary()["step_check"]
+        assert compact.summary["warnings"] == alone.summary()["warnings"]
+    assert [c.summary["step_check"]["within"] for c in out] == [False, True]  # the light rig's warning travels
+    assert any("step" in w for w in out[0].summary["warnings"])
+    assert "step_check" not in run_batch(specs[:1], workers=1, reduce=Compact(every=10))[0].summary
+    with pytest.raises(TypeError, match="check_step"):
+        Compact(check_step="yes")

@@ -195,8 +195,8 @@ def check_step(result, engine: str = "compiled", progress=False, remedy: str = R
 
     if not isinstance(result, SimulationResult):
         raise TypeError(f"the step check needs a SimulationResult, not a {type(result).__name__}: it reads the "
-                        "run's own samples and sub-step count (for a batch's run, check "
-                        "smafinger.engine.run.run_spec(result.spec), or give a sweep check_step = true)")
+                        "run's own samples and sub-step count (in a batch: reduce=Compact(check_step=True); in a "
+                        "sweep: check_step = true)")
     spec = result.spec
     half = half_step(spec)
     try:

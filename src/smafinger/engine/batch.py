@@ -156,16 +156,28 @@ class Compact:
 
     A 20 s run at 1 ms output keeps 20,001 samples per signal: 80 kB per float32 signal
     instead of the result's full float64 table.
+
+    With ``check_step`` the worker also runs each spec at half its step
+    (:func:`smafinger.step_check.with_step_check`, about twice the run's time): the summary gets
+    ``step_check`` and, over the budget, its warning. A compact result cannot be checked
+    afterwards: it keeps too little of the run.
     """
 
     signals: tuple[str, ...] | None = None
     every: int = 1
+    check_step: bool = False
 
     def __post_init__(self):
         if int(self.every) < 1:
             raise ValueError(f"every = {self.every!r} must be >= 1")
+        if not isinstance(self.check_step, bool):
+            raise TypeError(f"check_step = {self.check_step!r} must be True or False")
 
     def __call__(self, result) -> CompactResult:
+        if self.check_step:
+            from ..step_check import with_step_check
+
+            result = with_step_check(result)
         return CompactResult(result.spec, result.summary(), compact_signals(result, self.signals, self.every),
                              int(self.every))
 
