@@ -67,3 +67,33 @@ def test_a_closed_stdout_ends_quietly_with_the_pipe_status():
     p.stdout.close()  # the reader went away before the first line
     err = p.stderr.read().decode()
     assert (p.wait(), err) == (141, "")
+
+
+def test_a_metrics_only_run_is_refused_a_plot_before_any_figure_is_made(tmp_path):
+    """A run that recorded only its metrics' signals has no velocity, target or drive: plot()
+    says so (it raised a KeyError from inside the drawing and left the figure open), and a
+    failed save closes its figure too."""
+    import matplotlib.pyplot as plt
+
+    from smafinger.engine.run import make_spec, run_spec
+
+    open_before = len(plt.get_fignums())
+    lean = run_spec(make_spec("paper2010", "cooperative", "0:-25", t_end_s=1.0), record="metrics")
+    with pytest.raises(ValueError, match="record='all'"):
+        lean.plot()
+    full = run_spec(lean.spec)
+    with pytest.raises(ValueError, match="does not exist"):  # refused before drawing
+        full.plot(tmp_path / "no-such-folder" / "r.png")
+    with pytest.raises(ValueError, match="xyz"):  # matplotlib refuses the format after drawing
+        full.plot(tmp_path / "r.xyz")
+    assert len(plt.get_fignums()) == open_before and list(tmp_path.iterdir()) == []
+    plt.close(full.plot())
+
+
+@pytest.mark.parametrize("every, error", [(-1, ValueError), (0, ValueError), (2.5, TypeError), (None, TypeError),
+                                          (True, TypeError)])
+def test_decimated_takes_a_positive_integer(run, every, error):
+    """decimated(-1) returned the run reversed in time, saved with samples_every = -1 (found by review)."""
+    with pytest.raises(error, match=f"every = {every!r}"):
+        run.decimated(every)
+    assert run.decimated(np.int64(4)).samples_every == 4

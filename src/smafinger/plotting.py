@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .files import atomic_write
+from .files import atomic_write, check_output
 
 
 def _mpl():
@@ -29,13 +29,37 @@ _COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 
 
 def plot_result(result, path: str | Path | None = None, title: str | None = None):
-    """Five stacked panels sharing the time axis; saved to ``path`` if given."""
+    """Five stacked panels sharing the time axis; saved to ``path`` if given (and then closed).
+
+    ValueError for a run that recorded only its metrics' signals (``record="metrics"``): the
+    panels need its velocity, target, drive and springs. A figure whose drawing or saving fails
+    is closed before the error goes on."""
+    if result.recorded is not None:
+        raise ValueError("plot needs every signal, and this run recorded only its metrics' signals "
+                         "(record='metrics'): run it with record='all'")
+    if path is not None:
+        check_output(path)
     plt = _mpl()
+    fig, ax = plt.subplots(5, 1, figsize=(7.5, 10.5), sharex=True, constrained_layout=True)
+    try:
+        _draw(result, fig, ax, title)
+        if path is not None:
+            suffix = Path(path).suffix.lstrip(".") or "png"
+            atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=130, format=suffix))
+    except BaseException:
+        plt.close(fig)
+        raise
+    if path is not None:
+        plt.close(fig)
+    return fig
+
+
+def _draw(result, fig, ax, title):
+    """The five panels of :func:`plot_result` on ``ax``."""
     p = result.spec.params
     q, q_ref, v, k, sym, q_label, v_label = _AXES[p.mechanism]
     t = result.t
     open_loop = result.spec.strategy == "open-loop"
-    fig, ax = plt.subplots(5, 1, figsize=(7.5, 10.5), sharex=True, constrained_layout=True)
     ax[0].plot(t, k * result.signal(q), color="k", label=sym)
     if not open_loop:  # open loop pursues no target
         ax[0].plot(t, k * result.signal(q_ref), color="tab:red", ls="--", lw=1.0, label="target")
@@ -64,8 +88,3 @@ def plot_result(result, path: str | Path | None = None, title: str | None = None
     for a in ax:
         a.grid(True, alpha=0.3)
     fig.suptitle(title or f"{p.name}, {result.spec.strategy}")
-    if path is not None:
-        suffix = Path(path).suffix.lstrip(".") or "png"
-        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=130, format=suffix))
-        plt.close(fig)
-    return fig

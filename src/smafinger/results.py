@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -117,8 +118,13 @@ class SimulationResult:
             raise AttributeError(name) from None
 
     def decimated(self, every: int) -> "SimulationResult":
-        """The result thinned to every ``every``-th sample, its metrics kept at full resolution;
-        its saved files say so (``samples_every`` in their provenance)."""
+        """The result thinned to every ``every``-th sample (an integer >= 1), its metrics kept at
+        full resolution; its saved files say so (``samples_every`` in their provenance)."""
+        if isinstance(every, bool) or not isinstance(every, numbers.Integral):
+            raise TypeError(f"every = {every!r} must be an integer >= 1")
+        if every < 1:
+            raise ValueError(f"every = {every!r} must be an integer >= 1")
+        every = int(every)
         metrics = self.metrics
         return dataclasses.replace(self, mechanism_signals=np.ascontiguousarray(self.mechanism_signals[:, ::every]),
                                    wire_signals=np.ascontiguousarray(self.wire_signals[..., ::every]),
