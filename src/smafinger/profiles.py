@@ -15,6 +15,7 @@ per wire: upper, lower), duties as fractions of the supply V_H (``kind="duty"``,
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,16 @@ class Segment:
     start_s: float | None
     target: float  #: in the mechanism's user unit (deg for the joint, m for the linear actuator)
     enable: str = "auto"
+
+    def __post_init__(self) -> None:
+        """Numbers kept as floats (a numpy scalar would reach the summary's JSON), the enable
+        word as text: :class:`ProfileError` naming the field otherwise."""
+        if self.start_s is not None:
+            object.__setattr__(self, "start_s", _real(self.start_s, "profile segment start_s"))
+        object.__setattr__(self, "target", _real(self.target, "profile segment target"))
+        if not isinstance(self.enable, str):
+            raise ProfileError(f"profile segment enable: {self.enable!r} is not a word (auto, none, both, all or a "
+                               "wire's name)")
 
     @property
     def target_deg(self) -> float:
@@ -52,6 +63,13 @@ class TargetProfile:
     segments: tuple[Segment, ...]
 
     def __post_init__(self) -> None:
+        if isinstance(self.segments, (str, bytes)) or not isinstance(self.segments, (tuple, list)):
+            raise ProfileError(f"profile: segments must be a tuple of Segment, not {type(self.segments).__name__} "
+                               "(TargetProfile.parse reads the text form)")
+        object.__setattr__(self, "segments", tuple(self.segments))
+        for i, s in enumerate(self.segments):
+            if not isinstance(s, Segment):
+                raise ProfileError(f"profile segment {i}: {s!r} is not a Segment(start_s, target, enable)")
         if not self.segments:
             raise ProfileError("profile: at least one segment is needed")
         if self.segments[0].start_s != 0.0:
@@ -69,6 +87,7 @@ class TargetProfile:
 
     @classmethod
     def parse(cls, text: str) -> "TargetProfile":
+        _text(text, "profile", "0:-25,reach:-55")
         segs = []
         for i, item in enumerate(p for p in text.split(",") if p.strip()):
             parts = [x.strip() for x in item.split(":")]
@@ -104,16 +123,25 @@ class VoltageProgram:
     def __post_init__(self) -> None:
         if self.kind not in DRIVE_KINDS:
             raise ProfileError(f"drive program kind {self.kind!r} is not one of {', '.join(DRIVE_KINDS)}")
-        if not self.steps:
+        rows = "every step needs a time and the same number of values (one per wire)"
+        try:
+            raw = np.asarray(self.steps)
+        except ValueError:  # rows of different lengths
+            raise ProfileError(f"drive program: {rows}") from None
+        if raw.size == 0:
             raise ProfileError("drive program: at least one step is needed")
-        widths = {len(st) for st in self.steps}
-        if len(widths) != 1 or min(widths) < 2:
-            raise ProfileError("drive program: every step needs a time and the same number of values (one per wire)")
-        if self.steps[0][0] != 0.0:
-            raise ProfileError(f"drive program: the first step must start at 0 s, not {self.steps[0][0]}")
+        if raw.ndim != 2 or raw.shape[1] < 2:
+            raise ProfileError(f"drive program: {rows}; steps must be rows (start_s, value_1, ...), not "
+                               f"{_short(self.steps)}")
+        if raw.dtype.kind not in "iuf":
+            raise ProfileError(f"drive program: steps must hold numbers, not {_short(self.steps)} "
+                               "(VoltageProgram.parse reads the text form)")
+        a = raw.astype(float)
+        object.__setattr__(self, "steps", tuple(map(tuple, a.tolist())))  # floats, as parse makes them
+        if a[0, 0] != 0.0:
+            raise ProfileError(f"drive program: the first step must start at 0 s, not {a[0, 0]!r}")
         # vectorised check of the whole program (a PWM program has thousands of steps);
         # the first bad step found in order gets the message
-        a = np.asarray(self.steps, dtype=float)
         t, v = a[:, 0], a[:, 1:]
         unit, top = DRIVE_KINDS[self.kind]
         bad_t = ~np.isfinite(t)
@@ -134,6 +162,7 @@ class VoltageProgram:
     @classmethod
     def parse(cls, text: str, kind: str = "voltage") -> "VoltageProgram":
         """``"T:V_1[:V_2...],..."``: a time and one value per wire."""
+        _text(text, f"{kind} program", "0:8:0,6:0:0")
         items = [p for p in text.split(",") if p.strip()]
         if not items:
             raise ProfileError(f"{kind} program {text!r}: no steps")
@@ -172,3 +201,22 @@ def _float(text: str, what: str) -> float:
     if not math.isfinite(v):
         raise ProfileError(f"{what}: {text!r} is not finite")
     return v
+
+
+def _real(value, what: str) -> float:
+    """``value`` (a real number, not a bool) as a float; :class:`ProfileError` naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ProfileError(f"{what}: {value!r} is not a number")
+    return float(value)
+
+
+def _text(text, what: str, example: str) -> None:
+    """:class:`ProfileError` unless ``text`` is a str (the text form, like ``example``)."""
+    if not isinstance(text, str):
+        raise ProfileError(f"{what}: {_short(text)} is not text (the form {example!r})")
+
+
+def _short(value) -> str:
+    """repr of ``value``, cut to 60 characters (a program can have thousands of steps)."""
+    r = repr(value)
+    return r if len(r) <= 60 else r[:57] + "..."
