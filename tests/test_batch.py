@@ -221,3 +221,29 @@ def test_scheduler_address_parsing():
     assert parse("localhost:8786") == ("tcp", "localhost", 8786)
     assert parse("tls://[::1]:9000") == ("tls", "::1", 9000)
     assert parse("tcp://sched") == ("tcp", "sched", None)
+
+
+def test_a_reduce_that_cannot_reach_the_workers_is_refused_before_any_task():
+    """A lambda ran with one worker and failed with two, with pickle's own error from inside the
+    pool (found by an API fuzz): now a TypeError naming it, before any task is sent."""
+    spec = make_spec("paper2010", "cooperative", "0:-25", t_end_s=0.5)
+    assert run_batch([spec], workers=1, reduce=lambda r: r.substeps) == [run_spec(spec).substeps]
+    with pools.LocalPool(1) as pool:
+        with pytest.raises(TypeError, match="reduce = <function .*lambda.* cannot be sent to the worker processes"):
+            run_batch([spec], pool=pool, reduce=lambda r: r.substeps)
+        assert run_batch([spec], pool=pool, reduce=batch.Compact(every=10))[0].every == 10  # the pool goes on
+
+
+@pytest.mark.parametrize("workers, error", [("2", TypeError), (1.5, TypeError), (True, TypeError), (0, ValueError)])
+def test_workers_must_be_a_whole_number(workers, error):
+    spec = make_spec("paper2010", "cooperative", "0:-25", t_end_s=0.5)
+    with pytest.raises(error, match=f"workers = {workers!r}"):
+        run_batch([spec], workers=workers)  # "2" met '<' against an int inside the pool's choice
+
+
+def test_specs_product_takes_one_value_or_a_list():
+    """specs_product("paper2010") ran over the name's letters ("unknown parameter set 'p'")."""
+    one = specs_product("paper2010", profiles="0:-25", strategy="cooperative", t_end_s=1.0)
+    assert one == specs_product(["paper2010"], profiles=["0:-25"], strategy="cooperative", t_end_s=1.0)
+    assert len(one) == 1
+    assert len(specs_product(get("paper2010"), voltages="0:8:0", strategy="open-loop", t_end_s=1.0)) == 1

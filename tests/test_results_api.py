@@ -90,10 +90,16 @@ def test_a_metrics_only_run_is_refused_a_plot_before_any_figure_is_made(tmp_path
     plt.close(full.plot())
 
 
-@pytest.mark.parametrize("every, error", [(-1, ValueError), (0, ValueError), (2.5, TypeError), (None, TypeError),
-                                          (True, TypeError)])
-def test_decimated_takes_a_positive_integer(run, every, error):
-    """decimated(-1) returned the run reversed in time, saved with samples_every = -1 (found by review)."""
+@pytest.mark.parametrize("every, error", [(-1, ValueError), (0, ValueError), (2.5, ValueError), (None, TypeError),
+                                          (True, TypeError), ("2", TypeError), (float("nan"), ValueError)])
+def test_decimated_and_compact_take_a_whole_number_of_samples(run, every, error):
+    """decimated(-1) returned the run reversed in time, saved with samples_every = -1, and
+    Compact(every=2.7) kept every 2nd sample (found by an API fuzz)."""
+    from smafinger.engine.batch import Compact
+
     with pytest.raises(error, match=f"every = {every!r}"):
         run.decimated(every)
-    assert run.decimated(np.int64(4)).samples_every == 4
+    with pytest.raises(error, match=f"every = {every!r}"):
+        Compact(every=every)
+    assert run.decimated(np.int64(4)).samples_every == 4 == run.decimated(4.0).samples_every
+    assert Compact(every=4.0).every == 4 and type(Compact(every=np.int64(4)).every) is int

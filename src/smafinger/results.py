@@ -120,11 +120,7 @@ class SimulationResult:
     def decimated(self, every: int) -> "SimulationResult":
         """The result thinned to every ``every``-th sample (an integer >= 1), its metrics kept at
         full resolution; its saved files say so (``samples_every`` in their provenance)."""
-        if isinstance(every, bool) or not isinstance(every, numbers.Integral):
-            raise TypeError(f"every = {every!r} must be an integer >= 1")
-        if every < 1:
-            raise ValueError(f"every = {every!r} must be an integer >= 1")
-        every = int(every)
+        every = sample_stride(every)
         metrics = self.metrics
         return dataclasses.replace(self, mechanism_signals=np.ascontiguousarray(self.mechanism_signals[:, ::every]),
                                    wire_signals=np.ascontiguousarray(self.wire_signals[..., ::every]),
@@ -211,6 +207,17 @@ class SimulationResult:
         from .plotting import plot_result
 
         return plot_result(self, path, title)
+
+
+def sample_stride(every) -> int:
+    """``every`` (keep every ``every``-th sample) as an int: a whole number >= 1 (10.0 is 10);
+    TypeError or ValueError naming it otherwise (-1 reversed a result in time, 2.7 kept every
+    2nd sample)."""
+    if isinstance(every, bool) or not isinstance(every, numbers.Real):
+        raise TypeError(f"every = {every!r} must be a whole number >= 1")
+    if not (math.isfinite(every) and every == int(every) and every >= 1):
+        raise ValueError(f"every = {every!r} must be a whole number >= 1")
+    return int(every)
 
 
 def segment_bounds(result: SimulationResult) -> list[tuple[int, float, float]]:

@@ -25,8 +25,10 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable, Iterator, Sequence
+from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -60,11 +62,13 @@ def specs_product(params: Iterable = ("paper2010",), profiles: Iterable | None =
                   voltages: Iterable | None = None, **common) -> list[RunSpec]:
     """Every combination of parameter sets and profiles (or voltage programs), validated.
 
-    ``common`` holds the other :func:`make_spec` arguments (strategy, t_end_s, ...).
+    Each of ``params``, ``profiles`` and ``voltages`` is a list of values, or one value (a
+    name, a path, a set, a profile text or object). ``common`` holds the other
+    :func:`make_spec` arguments (strategy, t_end_s, ...).
     """
-    params = list(params)
-    second = [("profile", p) for p in profiles] if profiles is not None else []
-    second += [("voltage", v) for v in voltages] if voltages is not None else []
+    params = _each(params)
+    second = [("profile", p) for p in _each(profiles)] if profiles is not None else []
+    second += [("voltage", v) for v in _each(voltages)] if voltages is not None else []
     if not second:
         second = [(None, None)]
     specs = []
@@ -75,6 +79,14 @@ def specs_product(params: Iterable = ("paper2010",), profiles: Iterable | None =
                 kw[name] = value
             specs.append(make_spec(params=p, **kw))
     return specs
+
+
+def _each(values) -> list:
+    """``values`` as a list; one value (text, a path, or anything not iterable) as a list of it
+    (``specs_product("paper2010")`` ran over the name's letters)."""
+    if isinstance(values, (str, bytes, os.PathLike)) or not isinstance(values, Iterable):
+        return [values]
+    return list(values)
 
 
 def chunked(tasks: Iterable, size: int) -> Iterator[list]:
@@ -168,8 +180,9 @@ class Compact:
     check_step: bool = False
 
     def __post_init__(self):
-        if int(self.every) < 1:
-            raise ValueError(f"every = {self.every!r} must be >= 1")
+        from ..results import sample_stride
+
+        object.__setattr__(self, "every", sample_stride(self.every))
         if not isinstance(self.check_step, bool):
             raise TypeError(f"check_step = {self.check_step!r} must be True or False")
 

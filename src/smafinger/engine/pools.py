@@ -17,7 +17,9 @@ is never all in memory at once.
 
 from __future__ import annotations
 
+import numbers
 import os
+import pickle
 import signal
 import threading
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -211,6 +213,18 @@ class LocalPool(SerialPool):
     def describe(self) -> str:
         return f"{self.slots} local worker process{'es' if self.slots > 1 else ''}"
 
+    def map_chunks(self, chunks, reduce=None, record="all"):
+        """As :meth:`SerialPool.map_chunks`; ``reduce`` must pickle, since it runs in the workers
+        (TypeError before any task is sent: a lambda ran with one worker and failed with two)."""
+        if reduce is not None:
+            try:
+                pickle.dumps(reduce)
+            except Exception as exc:
+                raise TypeError(f"reduce = {reduce!r} cannot be sent to the worker processes ({exc}): give a "
+                                "function defined at a module's top level, a functools.partial of one, or "
+                                "Compact(...)") from None
+        return super().map_chunks(chunks, reduce, record)
+
     def start(self) -> "LocalPool":
         """Start and warm up every worker now (otherwise it happens with the first tasks)."""
         list(self._ex.map(warmed_in, range(self.slots)))
@@ -265,6 +279,8 @@ def make_pool(workers: int | None = None, scheduler=None, connect_timeout_s: flo
         from .dask_pool import DaskPool
 
         return DaskPool(scheduler, timeout_s=connect_timeout_s)
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, numbers.Integral)):
+        raise TypeError(f"workers = {workers!r} must be an integer >= 1 (or None: every core)")
     if workers is not None and workers < 1:
         raise ValueError(f"workers = {workers!r} must be >= 1")
     n = workers or available_cores()
