@@ -336,3 +336,17 @@ def test_a_ctrl_c_is_classified_without_importing_the_engine(monkeypatch):
     monkeypatch.setitem(sys.modules, "smafinger.engine.pools", None)  # importing it raises ImportError
     monkeypatch.setitem(sys.modules, "smafinger.engine.run", None)
     assert classify(KeyboardInterrupt()) == (EXIT_INTERRUPTED, "smafinger: interrupted (Ctrl-C)")
+
+
+def test_a_blow_up_in_the_python_api_says_what_to_change_in_its_terms():
+    """smafinger.simulate's blow-up had no hint (only the command and sweeps added one), while
+    numerics' docstring promised it names the extreme parameter (found by an API fuzz)."""
+    from smafinger import SimulationError, simulate
+    from smafinger.parameters import get
+
+    p = get("paper2010-table2").replace(inertia_kg_m2=1e-9)
+    with pytest.raises(SimulationError) as err:
+        simulate(p, "open-loop", voltage="0:8:0,10:0:0", method="euler", t_end_s=20.0)
+    assert str(err.value).startswith("numerical blow-up at t = ")
+    assert str(err.value).endswith("use a smaller dt_s or method='exponential'; check inertia_kg_m2 = 1e-09 "
+                                   "(48800x below paper2010's 4.88e-05)")

@@ -198,9 +198,10 @@ def extreme_parameters(params) -> list[str]:
 
 
 
-def hinted(spec, run):
+def hinted(spec, run, style: str = "cli"):
     """``run()`` (a run of ``spec``), a numerical blow-up's message saying what to change
-    (:func:`blowup_hint`); a duty that is not a number as it is (the step is not what to change)."""
+    (:func:`blowup_hint` in ``style``); a duty that is not a number as it is (the step is not
+    what to change)."""
     from .engine.run import DutyNotANumber, SimulationError
 
     try:
@@ -208,22 +209,28 @@ def hinted(spec, run):
     except DutyNotANumber:
         raise
     except SimulationError as exc:
-        raise SimulationError(f"{exc}; {blowup_hint(spec)}") from None
+        raise SimulationError(f"{exc}; {blowup_hint(spec, style)}") from None
 
 
-def blowup_hint(spec) -> str:
-    """What to change after a run blew up: the step, the method, the parameter that looks extreme."""
+#: how a hint names the step and the method: the command line's options, or the Python API's arguments
+HINT_STYLES = {"cli": ("--dt", "--method {}"), "api": ("dt_s", "method='{}'")}
+
+
+def blowup_hint(spec, style: str = "cli") -> str:
+    """What to change after a run blew up: the step, the method, the parameter that looks
+    extreme; named as options (``style="cli"``) or as :func:`smafinger.simulate`'s arguments."""
     from .engine.numerics import damping_rate_per_s, damping_step_limit
 
+    dt, method = HINT_STYLES[style]
     limit = damping_step_limit(spec.params, spec.method)
     if limit is not None and spec.dt_s > limit:
         hint = (f"{spec.method} is stable only up to dt = {limit * 1e3:.2g} ms against this set's damping "
-                f"({damping_rate_per_s(spec.params):.4g} 1/s; now {spec.dt_s * 1e3:g} ms): use a smaller --dt or "
-                "--method exponential")
+                f"({damping_rate_per_s(spec.params):.4g} 1/s; now {spec.dt_s * 1e3:g} ms): use a smaller {dt} or "
+                f"{method.format('exponential')}")
     else:
-        hint = f"try a smaller --dt (now {spec.dt_s:g} s)"
+        hint = f"try a smaller {dt} (now {spec.dt_s:g} s)"
         if spec.method != "rk4":
-            hint += " or --method rk4"
+            hint += f" or {method.format('rk4')}"
     extreme = extreme_parameters(spec.params)
     if extreme:
         hint += f"; check {extreme[0]}"

@@ -14,6 +14,7 @@ from ..control.params import ControllerParameters, controller_from
 from ..control.strategies import STRATEGIES, enable_mask
 from ..model.build import build_model
 from ..parameters import ParameterSet, resolve
+from ..plausibility import hinted
 from ..progress import Display
 from ..profiles import ProfileError, TargetProfile, VoltageProgram
 from ..results import SimulationResult
@@ -396,8 +397,10 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     ParameterError, ProfileError, ValueError, TypeError
         Bad input, before anything runs; the message names the argument or field and the value.
     SimulationError
-        The state became NaN or Inf (a numerical blow-up), with the time and the state;
-        :class:`DutyNotANumber` if the controller commanded a duty that is no number.
+        The state became NaN or Inf (a numerical blow-up), with the time, the state and what to
+        change (the step, the method, a parameter that looks extreme;
+        :func:`~smafinger.plausibility.blowup_hint`); :class:`DutyNotANumber` if the controller
+        commanded a duty that is no number.
     """
     spec = make_spec(params, strategy, profile, voltage, t_end_s, dt_s, method, output_interval_s,
                      tol_deg, hold_s, independent_wait, tol_m, drive, pwm, controller)
@@ -408,7 +411,7 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
 
         half_step(spec)  # a step with no shorter one is refused before the run
     setting = interpreted.engine_setting(engine)
-    result = run_spec(spec, progress=progress, engine=setting)
+    result = hinted(spec, lambda: run_spec(spec, progress=progress, engine=setting), style="api")
     if check_step:  # asked for: made, however long interpreted
         from ..step_check import check_engine, with_step_check
 
