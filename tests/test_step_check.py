@@ -278,6 +278,9 @@ def test_a_pwm_far_faster_than_the_step_is_not_judged():
     chk = fast.step_check
     assert chk.refinement < MIN_REFINEMENT and not chk.judged and chk.within is None
     assert "not judged" in chk.describe() and math.isnan(chk.estimated_rms) and fast.metrics["warnings"] == []
+    d = fast.summary()["step_check"]  # strict JSON: null, not NaN (found by an API fuzz)
+    assert (d["judged"], d["factor"], d["estimated_rms"], d["estimated_max"], d["within"]) == (False,) + (None,) * 4
+    json.dumps(fast.summary(), allow_nan=False)
     assert chk.to_dict()["judged"] is False
     slow = simulate(p, "open-loop", **kw).step_check  # the template's 1 kHz: judged
     assert slow.judged and slow.refinement > 1.5 and slow.within

@@ -137,10 +137,12 @@ class StepCheck:
 
     def to_dict(self) -> dict:
         """JSON-ready: the fields, the refinement, the estimate and whether it is within the
-        budget (``within`` null where not judged)."""
-        return {**dataclasses.asdict(self), "refinement": self.refinement, "judged": self.judged,
-                "factor": self.factor, "estimated_rms": self.estimated_rms, "estimated_max": self.estimated_max,
-                "within": self.within}
+        budget (``factor``, the estimates and ``within`` null where not judged: NaN is not JSON)."""
+        judged = self.judged
+        return {**dataclasses.asdict(self), "refinement": self.refinement, "judged": judged,
+                "factor": self.factor if judged else None,
+                "estimated_rms": self.estimated_rms if judged else None,
+                "estimated_max": self.estimated_max if judged else None, "within": self.within}
 
 
 def checked_by_default(params, validated: bool = False) -> bool:
