@@ -289,3 +289,18 @@ def test_ctrl_c_after_the_outputs_are_in_place_says_so(tmp_path, monkeypatch, wh
     assert r.exit_code == 130
     assert f"interrupted (Ctrl-C) after the outputs were written to {out}" in r.output
     assert (out / "goals.json").exists()
+
+
+@pytest.mark.parametrize("value, ok", [(np.float32(300.0), True), (np.int64(300), True), (300, True),
+                                       (np.True_, False), ("300", False), (10 ** 400, False)])
+def test_a_controllers_numbers_are_checked_as_a_sets_are(value, ok):
+    """np.float32 was refused as "not a number" by a controller while a parameter set took it
+    (found by an API fuzz); an int beyond any float is out of range, not an OverflowError."""
+    from smafinger.parameters import ParameterError
+
+    if ok:
+        pid = PaperPID(K_V_s_per_q=value)
+        assert pid.K_V_s_per_q == 300.0 and type(pid.K_V_s_per_q) is float
+    else:
+        with pytest.raises(ParameterError, match="K_V_s_per_q = "):
+            PaperPID(K_V_s_per_q=value)

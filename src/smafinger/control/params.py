@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
@@ -65,12 +66,16 @@ class ControllerParameters:
             v = getattr(self, f.name)
             if "range" not in f.metadata or v is None:
                 continue
-            if isinstance(v, bool) or not isinstance(v, (int, float)):
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):  # numpy's numbers too (np.float32 was refused)
                 raise ParameterError(f"{self.label}: {f.name} = {v!r} is not a number")
             lo, hi = f.metadata["range"]
-            if not math.isfinite(v) or not lo <= v <= hi:
-                raise ParameterError(f"{self.label}: {f.name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
-            object.__setattr__(self, f.name, float(v))
+            try:
+                x = float(v)
+            except OverflowError:  # an int beyond any float
+                x = math.inf
+            if not math.isfinite(x) or not lo <= x <= hi:
+                raise ParameterError(f"{self.label}: {f.name} = {v!r:.40} is outside the allowed range [{lo:g}, {hi:g}]")
+            object.__setattr__(self, f.name, x)
 
     @classmethod
     def field_names(cls) -> list[str]:
