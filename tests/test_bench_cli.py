@@ -302,5 +302,5 @@ def test_a_controllers_numbers_are_checked_as_a_sets_are(value, ok):
         pid = PaperPID(K_V_s_per_q=value)
         assert pid.K_V_s_per_q == 300.0 and type(pid.K_V_s_per_q) is float
     else:
-        with pytest.raises(ParameterError, match="K_V_s_per_q = "):
+        with pytest.raises(ParameterError, match="pid.*: K_V_s_per_q(:| =) "):
             PaperPID(K_V_s_per_q=value)

@@ -44,3 +44,12 @@ def test_numbers_of_any_kind_are_kept_as_floats():
     prog = VoltageProgram(np.array([[0.0, 8.0, 0.0], [1.0, 0.0, 0.0]], dtype=np.float32))
     assert prog == VoltageProgram.parse("0:8:0,1:0:0")
     assert {type(v) for st in prog.steps for v in st} == {float}
+
+
+def test_the_command_line_prints_a_programs_start_as_a_number(capsys):
+    """The start read from text is a numpy scalar inside the check: printed as 1.0, not
+    np.float64(1.0) (found by review)."""
+    from smafinger.cli import main
+
+    assert main(["simulate", "--strategy", "open-loop", "--voltage", "1:8:0,6:0:0", "--t-end", "1"]) == 2
+    assert "the first step must start at 0 s, not 1.0\n" in capsys.readouterr().err

@@ -337,6 +337,7 @@ def test_a_sweep_rows_blow_up_says_what_to_change(tmp_path):
     df = pd.read_parquet(tmp_path / "s.parquet").sort_values("point")
     assert df["status"].tolist() == ["ok", "error"]
     assert "numerical blow-up" in df["error"].iloc[1] and "check inertia_kg_m2 = 1e-09" in df["error"].iloc[1]
+    assert 'use a smaller dt_s or method = "exponential"' in df["error"].iloc[1]  # its file's keys, not --dt
 
 
 def test_a_compact_batch_result_is_refused_by_name():
@@ -368,3 +369,24 @@ def test_a_batch_checks_its_runs_in_the_workers_when_asked():
     assert "step_check" not in run_batch(specs[:1], workers=1, reduce=Compact(every=10))[0].summary
     with pytest.raises(TypeError, match="check_step"):
         Compact(check_step="yes")
+
+
+def test_a_failed_check_in_python_says_what_skips_it_there(monkeypatch):
+    """The run at half the step stopping: simulate(check_step=True) and Compact(check_step=True)
+    name their own argument, not the command's --no-check-step (found by review)."""
+    import smafinger.engine.run as engine_run
+    from smafinger.engine.batch import Compact
+
+    real = engine_run.run_spec
+    spec = make_spec("paper2010", "cooperative", "0:-30", t_end_s=1.0)
+
+    def stops_at_half_step(s, *args, **kwargs):
+        if s.dt_s < spec.dt_s:
+            raise engine_run.SimulationError("numerical blow-up at t = 0.5 s (on purpose)")
+        return real(s, *args, **kwargs)
+
+    monkeypatch.setattr(engine_run, "run_spec", stops_at_half_step)
+    for call in (lambda: Compact(check_step=True)(real(spec)),
+                 lambda: simulate("paper2010", "cooperative", "0:-30", t_end_s=1.0, check_step=True)):
+        with pytest.raises(engine_run.SimulationError, match=r"stopped \(check_step=False skips the check\)"):
+            call()

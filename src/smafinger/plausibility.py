@@ -212,13 +212,14 @@ def hinted(spec, run, style: str = "cli"):
         raise SimulationError(f"{exc}; {blowup_hint(spec, style)}") from None
 
 
-#: how a hint names the step and the method: the command line's options, or the Python API's arguments
-HINT_STYLES = {"cli": ("--dt", "--method {}"), "api": ("dt_s", "method='{}'")}
+#: how a hint names the step and the method: the command line's options, the Python API's arguments, a sweep file's keys
+HINT_STYLES = {"cli": ("--dt", "--method {}"), "api": ("dt_s", "method='{}'"), "toml": ("dt_s", 'method = "{}"')}
 
 
 def blowup_hint(spec, style: str = "cli") -> str:
     """What to change after a run blew up: the step, the method, the parameter that looks
-    extreme; named as options (``style="cli"``) or as :func:`smafinger.simulate`'s arguments."""
+    extreme; named as options (``style="cli"``), as :func:`smafinger.simulate`'s arguments
+    (``"api"``) or as a sweep file's keys (``"toml"``)."""
     from .engine.numerics import damping_rate_per_s, damping_step_limit
 
     dt, method = HINT_STYLES[style]

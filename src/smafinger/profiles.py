@@ -15,10 +15,11 @@ per wire: upper, lower), duties as fractions of the supply V_H (``kind="duty"``,
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
+
+from .values import is_real
 
 
 
@@ -139,7 +140,7 @@ class VoltageProgram:
         a = raw.astype(float)
         object.__setattr__(self, "steps", tuple(map(tuple, a.tolist())))  # floats, as parse makes them
         if a[0, 0] != 0.0:
-            raise ProfileError(f"drive program: the first step must start at 0 s, not {a[0, 0]!r}")
+            raise ProfileError(f"drive program: the first step must start at 0 s, not {float(a[0, 0])!r}")
         # vectorised check of the whole program (a PWM program has thousands of steps);
         # the first bad step found in order gets the message
         t, v = a[:, 0], a[:, 1:]
@@ -205,7 +206,7 @@ def _float(text: str, what: str) -> float:
 
 def _real(value, what: str) -> float:
     """``value`` (a real number, not a bool) as a float; :class:`ProfileError` naming ``what``."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    if not is_real(value):
         raise ProfileError(f"{what}: {value!r} is not a number")
     return float(value)
 

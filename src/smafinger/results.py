@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -13,6 +12,7 @@ import numpy as np
 
 from .engine.signals import MC, WC, columns, structured
 from .parameters import changed_from_named
+from .values import is_real
 from .files import atomic_write, temp_path  # noqa: F401  (re-exported: older imports)
 from .metrics import time_to_reach  # noqa: F401  (re-exported: defined in metrics)
 
@@ -213,7 +213,7 @@ def sample_stride(every) -> int:
     """``every`` (keep every ``every``-th sample) as an int: a whole number >= 1 (10.0 is 10);
     TypeError or ValueError naming it otherwise (-1 reversed a result in time, 2.7 kept every
     2nd sample)."""
-    if isinstance(every, bool) or not isinstance(every, numbers.Real):
+    if not is_real(every):
         raise TypeError(f"every = {every!r} must be a whole number >= 1")
     if not (math.isfinite(every) and every == int(every) and every >= 1):
         raise ValueError(f"every = {every!r} must be a whole number >= 1")

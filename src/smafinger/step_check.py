@@ -162,6 +162,8 @@ def checked_by_default(params, validated: bool = False) -> bool:
 
 #: what a failed check advises by default (``smafinger simulate``'s option)
 REMEDY = "--no-check-step skips the check"
+#: the same for the Python API's check_step arguments (simulate, Compact)
+API_REMEDY = "check_step=False skips the check"
 
 
 def check_step(result, engine: str = "compiled", progress=False, remedy: str = REMEDY) -> StepCheck:
@@ -290,5 +292,5 @@ def with_step_check(result, engine: str = "compiled", progress=False, remedy: st
     return dataclasses.replace(new, _metrics={**m, "warnings": warnings})
 
 
-__all__ = ["ASSUMED_ORDER", "MIN_REFINEMENT", "REMEDY", "StepCheck", "samples_per_sample", "check_engine", "check_step", "checked_by_default", "compare", "half_step",
+__all__ = ["API_REMEDY", "ASSUMED_ORDER", "MIN_REFINEMENT", "REMEDY", "StepCheck", "samples_per_sample", "check_engine", "check_step", "checked_by_default", "compare", "half_step",
            "uncheckable", "with_step_check"]

@@ -238,7 +238,7 @@ def run_block(template: SweepTemplate, points: list[int], ids: list[str], column
                 raise RuntimeError(f"internal error: point {point} was checked as run {rid} but builds "
                                    f"run {run_id(spec)}")
             record = "all" if traces_interval_s else "metrics"
-            result = hinted(spec, lambda: run_spec(spec, record=record))
+            result = hinted(spec, lambda: run_spec(spec, record=record), style="toml")
             r = row(with_step_check(result, remedy=SWEEP_CHECK_REMEDY) if check_step else result, traces_interval_s)
         except Exception as exc:  # noqa: BLE001 - reported per run, the sweep goes on
             r = error_row(exc)

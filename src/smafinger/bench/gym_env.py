@@ -26,7 +26,6 @@ then compared on the same plant and tasks as the built-in controllers (docs/cont
 from __future__ import annotations
 
 import math
-import numbers
 from typing import Any
 
 import numpy as np
@@ -36,6 +35,7 @@ from ..model.build import build_model
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
 from ..profiles import VoltageProgram
+from ..values import is_real
 from .runner import BENCH_NUMERICS
 
 
@@ -69,7 +69,7 @@ class PlantSession:
             raise ValueError(f"episode_s = {episode_s!r} is not a whole number of control intervals of "
                              f"{self.dt:g} s")
         c = self.params.coordinate
-        if target is not None and not (_real(target) and math.isfinite(target) and abs(target) <= c.limit):
+        if target is not None and not (is_real(target) and math.isfinite(target) and abs(target) <= c.limit):
             raise ValueError(f"target = {target!r} must be a finite number within +-{c.limit:g} {c.unit}")
         self.target = float(self.params.initial_target if target is None else target)
         if not isinstance(temperature_sensors, (bool, np.bool_)):
@@ -166,19 +166,14 @@ class PlantSession:
         return int(self.result.interlock_violations) if self.result is not None else 0
 
 
-def _real(v) -> bool:
-    """A real number, not a bool (True is not an interval of 1 s)."""
-    return isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))
-
-
 def _positive(name: str, v) -> float:
-    if not (_real(v) and math.isfinite(v) and v > 0):
+    if not (is_real(v) and math.isfinite(v) and v > 0):
         raise ValueError(f"{name} = {v!r} must be a finite number > 0")
     return float(v)
 
 
 def _finite(name: str, v, low: float = -math.inf) -> float:
-    if not (_real(v) and math.isfinite(v) and v >= low):
+    if not (is_real(v) and math.isfinite(v) and v >= low):
         raise ValueError(f"{name} = {v!r} must be a finite number" + (f" >= {low:g}" if low > -math.inf else ""))
     return float(v)
 

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 from ..model.records import Controller
-from ..parameters.base import ParameterSet
+from ..parameters.base import ParameterSet, checked_real
 from ..parameters.errors import ParameterError
 from .calibration import ResistanceCalibration, calibrate
 from .chain import NO_SHAPING, ControlChain, Estimator, Law, PIDGains
@@ -66,16 +65,8 @@ class ControllerParameters:
             v = getattr(self, f.name)
             if "range" not in f.metadata or v is None:
                 continue
-            if isinstance(v, bool) or not isinstance(v, numbers.Real):  # numpy's numbers too (np.float32 was refused)
-                raise ParameterError(f"{self.label}: {f.name} = {v!r} is not a number")
-            lo, hi = f.metadata["range"]
-            try:
-                x = float(v)
-            except OverflowError:  # an int beyond any float
-                x = math.inf
-            if not math.isfinite(x) or not lo <= x <= hi:
-                raise ParameterError(f"{self.label}: {f.name} = {v!r:.40} is outside the allowed range [{lo:g}, {hi:g}]")
-            object.__setattr__(self, f.name, x)
+            lo, hi = f.metadata["range"]  # checked as a set's fields are (np.float32 was refused)
+            object.__setattr__(self, f.name, checked_real(f.name, v, lo, hi, prefix=f"{self.label}: "))
 
     @classmethod
     def field_names(cls) -> list[str]:

@@ -188,9 +188,9 @@ class Compact:
 
     def __call__(self, result) -> CompactResult:
         if self.check_step:
-            from ..step_check import with_step_check
+            from ..step_check import API_REMEDY, with_step_check
 
-            result = with_step_check(result)
+            result = with_step_check(result, remedy=API_REMEDY)
         return CompactResult(result.spec, result.summary(), compact_signals(result, self.signals, self.every),
                              int(self.every))
 

@@ -17,7 +17,6 @@ is never all in memory at once.
 
 from __future__ import annotations
 
-import numbers
 import os
 import pickle
 import signal
@@ -26,6 +25,7 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from functools import partial
 from typing import Any, Callable, Iterable, Iterator, Sequence
 
+from ..values import is_whole
 from .forking import available_cores, mp_context, start_forkserver  # noqa: F401 (re-exported)
 from .run import RunSpec, kernel_cached, make_spec, run_spec
 
@@ -279,7 +279,7 @@ def make_pool(workers: int | None = None, scheduler=None, connect_timeout_s: flo
         from .dask_pool import DaskPool
 
         return DaskPool(scheduler, timeout_s=connect_timeout_s)
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, numbers.Integral)):
+    if workers is not None and not is_whole(workers):
         raise TypeError(f"workers = {workers!r} must be an integer >= 1 (or None: every core)")
     if workers is not None and workers < 1:
         raise ValueError(f"workers = {workers!r} must be >= 1")

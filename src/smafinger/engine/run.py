@@ -413,7 +413,7 @@ def simulate(params="paper2010", strategy="cooperative", profile=None, voltage=N
     setting = interpreted.engine_setting(engine)
     result = hinted(spec, lambda: run_spec(spec, progress=progress, engine=setting), style="api")
     if check_step:  # asked for: made, however long interpreted
-        from ..step_check import check_engine, with_step_check
+        from ..step_check import API_REMEDY, check_engine, with_step_check
 
-        result = with_step_check(result, check_engine(result, setting, skip_long=False))
+        result = with_step_check(result, check_engine(result, setting, skip_long=False), remedy=API_REMEDY)
     return result

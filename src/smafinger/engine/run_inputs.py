@@ -13,6 +13,7 @@ from ..profiles import DRIVE_KINDS, TargetProfile, VoltageProgram
 from . import integrators, pwm as pwm_models
 from .clock import TICK_S
 from .defaults import DEFAULT_TOL_DEG, DEFAULT_TOL_M
+from ..values import is_real
 
 #: make_spec arguments -> (accepted types, what to give)
 _NUMBER = "a number"
@@ -36,8 +37,7 @@ def check_types(**args) -> None:
             ok = isinstance(value, types)
         else:
             want = _NUMBER
-            ok = (isinstance(value, (int, float, np.integer, np.floating))
-                  and not isinstance(value, (bool, np.bool_)))
+            ok = is_real(value)
         if not ok:
             raise TypeError(f"{name} = {value!r} is not {want}")
     if args["drive"] not in DRIVE_KINDS:

@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
+from ..values import is_real
 from .errors import ParameterError
 from .options import OPTION_NAMES, OPTION_TYPES, ModelOptions, parse_option
 
@@ -230,20 +230,27 @@ def parse_value(name: str, raw: str, cls: type | None = None) -> Any:
     return raw.strip('"').strip("'")
 
 
+def checked_real(name: str, v: Any, lo: float, hi: float, prefix: str = "") -> float:
+    """``v`` as a float within [lo, hi] (:func:`smafinger.values.is_real`); :class:`ParameterError`
+    naming ``prefix`` + ``name`` and the value otherwise (an int beyond any float is out of range)."""
+    if not is_real(v):
+        raise ParameterError(f"{prefix}{name}: {v!r} is not a number")
+    try:
+        x = float(v)
+    except OverflowError:
+        x = math.inf
+    if not math.isfinite(x) or not (lo <= x <= hi):
+        raise ParameterError(f"{prefix}{name} = {v!r:.40} is outside the allowed range [{lo:g}, {hi:g}]")
+    return x
+
+
 def _checked_field(f: dataclasses.Field, v: Any) -> Any:
     """``v`` checked against the field's kind and range: a number as a Python float (an int, a
     numpy scalar), other kinds as given; :class:`ParameterError` naming the field and the value."""
     kind = f.metadata["kind"]
     if kind == "float":
-        if isinstance(v, bool) or not isinstance(v, numbers.Real):  # numpy's bool is no numbers.Real
-            raise ParameterError(f"{f.name}: {v!r} is not a number")
         lo, hi = f.metadata["range"]
-        try:
-            x = float(v)
-        except OverflowError:  # an int beyond any float
-            raise ParameterError(f"{f.name} = {v!r:.40} is outside the allowed range [{lo:g}, {hi:g}]") from None
-        if not math.isfinite(x) or not (lo <= x <= hi):
-            raise ParameterError(f"{f.name} = {v!r} is outside the allowed range [{lo:g}, {hi:g}]")
+        x = checked_real(f.name, v, lo, hi)
         return v if type(v) is float else x
     if kind == "str":
         if not isinstance(v, str):
