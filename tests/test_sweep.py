@@ -159,6 +159,11 @@ def test_random_and_lhs_sampling_seeded():
     ('[vary]\n', r"\[vary\]: is missing or empty"),
     ('[vary]\nh0_heating_W_m2K = {values = [1.0], step = 2}\n', "unknown key.*step"),
     ('[varry]\nx = 1\n[vary]\nh0_heating_W_m2K = [60.0]\n', "unknown table.*varry"),
+    # a varied name that is one of the table's columns wrote it twice, and an unreadable table
+    ('[vary]\nstatus = {fields = ["h0_heating_W_m2K"], values = [20.0, 30.0]}\n',
+     r"\[vary\] status: is the name of one of the table's own columns"),
+    ('[vary]\npoint = {fields = ["h0_heating_W_m2K"], values = [20.0]}\n', r"\[vary\] point: is the name"),
+    ('[vary]\nseg0_start_s = {fields = ["h0_heating_W_m2K"], values = [20.0]}\n', r"\[vary\] seg0_start_s: is the"),
 ])
 def test_bad_specs_name_field_and_value(tmp_path, text, message):
     p = _write(tmp_path, _spec(text))

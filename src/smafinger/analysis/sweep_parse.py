@@ -8,6 +8,7 @@ the file, the field and the value. The points themselves are checked later, in t
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -124,6 +125,8 @@ def parse_spec(data: dict, source: str = "<dict>", base_dir: Path = Path("."),
     if not isinstance(vary, dict) or not vary:
         raise _err(source, "[vary]", "is missing or empty: name at least one varied parameter")
     used_fields: dict[str, str] = {}
+    for vname in vary:
+        _check_column_name(source, vname)
     varies = [_parse_vary(source, vname, entry, settings["mode"], b, used_fields, max_runs)
               for vname, entry in vary.items()]
     if settings["mode"] == "list":
@@ -131,6 +134,18 @@ def parse_spec(data: dict, source: str = "<dict>", base_dir: Path = Path("."),
         if len(set(lengths.values())) > 1:
             raise _err(source, "[vary]", f"mode = 'list' pairs the i-th values of every name; the lengths differ: {lengths}")
     return SweepSpec(base=b, vary=tuple(varies), source=source, base_dir=base_dir, **settings)
+
+
+def _check_column_name(source: str, vname: str) -> None:
+    """A varied name becomes a column of the table beside the run's: it must not be one of
+    them (a [vary] status wrote two 'status' columns, both the varied values, and a table
+    neither pandas nor a resume could read; found by an API fuzz)."""
+    from .sweep_rows import METRIC_COLUMNS
+
+    if vname in ("run_id", "point", *METRIC_COLUMNS) or re.fullmatch(r"seg\d+_.*", vname):
+        raise _err(source, f"[vary] {vname}", "is the name of one of the table's own columns (run_id, point, "
+                   "status, error, the metrics, seg<k>_...): name the varied values otherwise, with fields = "
+                   "[...] naming the parameter")
 
 
 def _parse_base(source: str, base: dict) -> dict[str, Any]:
