@@ -21,6 +21,7 @@ all of its outputs or none. Every output says how it was made
 from __future__ import annotations
 
 import json
+import numbers
 import os
 from pathlib import Path
 
@@ -177,10 +178,11 @@ def read_provenance(path: str | Path) -> dict:
             import pyarrow.parquet as pq
 
             meta = pq.read_schema(path).metadata or {}
-            return json.loads(meta[PARQUET_KEY]) if PARQUET_KEY in meta else _none(path)
-        if suffix == ".mat":
+            doc = json.loads(meta[PARQUET_KEY]) if PARQUET_KEY in meta else _none(path)
+        elif suffix == ".mat":
             return _mat_provenance(path)
-        doc = json.loads(path.read_text())
+        else:
+            doc = json.loads(path.read_text())
     except ProvenanceError:
         raise
     except _read_errors() as exc:
@@ -193,12 +195,15 @@ def read_provenance(path: str | Path) -> dict:
 
 
 def _read_errors() -> tuple[type[BaseException], ...]:
-    """What reading a damaged JSON, Parquet or MATLAB file raises."""
+    """What reading a damaged JSON, Parquet or MATLAB file raises (scipy's reader: zlib's error on
+    a damaged compressed variable, an UnboundLocalError on some damaged headers)."""
+    import zlib
+
     import pyarrow
     from scipy.io.matlab import MatReadError
 
     return (OSError, ValueError, KeyError, TypeError, IndexError, UnicodeDecodeError, MatReadError,
-            pyarrow.ArrowException)
+            pyarrow.ArrowException, zlib.error, NameError)
 
 
 def _mat_provenance(path: Path) -> dict:
@@ -206,14 +211,15 @@ def _mat_provenance(path: Path) -> dict:
     from scipy.io import loadmat
 
     data = loadmat(path, squeeze_me=True, chars_as_strings=True)
-    if "provenance" not in data or "run_json" not in (data["provenance"].dtype.names or ()):
+    prov = data.get("provenance")
+    if "run_json" not in (getattr(getattr(prov, "dtype", None), "names", None) or ()):  # a struct with run_json
         return _none(path)
-    prov = data["provenance"]
     record = {"run": json.loads(str(prov["run_json"][()]))}
     for name in prov.dtype.names:  # run_sha256, and what the run recorded beside it (a scenario's name)
         value = prov[name][()]
-        if name not in ("run", "run_json") and isinstance(value, (str, np.generic)):
-            record[name] = value if isinstance(value, str) else value.item()
+        if name not in ("run", "run_json") and isinstance(value, (str, numbers.Number)):
+            # a number comes back as numpy's or Python's (samples_every was dropped as a Python float)
+            record[name] = value.item() if isinstance(value, np.generic) else value
     return record
 
 

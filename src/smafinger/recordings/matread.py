@@ -88,8 +88,10 @@ def open_mat(path, smap: SignalMap) -> MatFile:
     except NotImplementedError:
         raise RecordingError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read; "
                              f"save it with save(..., '-v7')") from None
-    except (MatReadError, ValueError, TypeError, IndexError, KeyError, EOFError, OSError, zlib.error) as exc:
-        # what scipy raises on a file that is not a MAT-file, or is truncated or corrupt
+    except (MatReadError, ValueError, TypeError, IndexError, KeyError, EOFError, OSError, zlib.error,
+            NameError) as exc:
+        # what scipy raises on a file that is not a MAT-file, or is truncated or corrupt (an
+        # UnboundLocalError, a NameError, on some damaged headers: found by an API fuzz)
         raise RecordingError(f"{path}: not a readable MATLAB file ({' '.join(str(exc).split())})") from None
     variables = {k: v for k, v in data.items() if not k.startswith("__")}
     header = data.get("__header__", b"")
@@ -122,12 +124,16 @@ def _check_own_time(e: _Entry, time_var: Source, t: np.ndarray | None) -> None:
     ``t_s`` that does not give the same times."""
     if t is not None and t.size == e.t_s.size and np.allclose(t, e.t_s, rtol=1e-9, atol=1e-12):
         return
-    got = ("no time vector of that name" if t is None else
-           f"{t.size} times from {t[0]:g} to {t[-1]:g} s" if t.size else "an empty vector")
+    got = "no time vector of that name" if t is None else _span(t, "times", "an empty vector")
     raise RecordingError(
-        f"{e.where}: is {e.own_time}, with its own time ({e.t_s.size} samples from {e.t_s[0]:g} to {e.t_s[-1]:g} s, "
+        f"{e.where}: is {e.own_time}, with its own time ({_span(e.t_s)}, "
         f"read in seconds as saved), but the mapping names t_s={time_var.to_text()} ({got}); remove t_s from the "
         "mapping, or save the signal as a plain vector beside its time vector")
+
+
+def _span(t: np.ndarray, noun: str = "samples", empty: str = "no samples") -> str:
+    """``t``'s size and range in words, ``empty`` for an empty one (it was indexed: found by an API fuzz)."""
+    return f"{t.size} {noun} from {t[0]:g} to {t[-1]:g} s" if t.size else empty
 
 
 def _sources(path, var, value, variables, time_var: Source, meta):

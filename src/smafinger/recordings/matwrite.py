@@ -103,6 +103,8 @@ def mat_variables(t_s, signals: Mapping[str, np.ndarray], provenance: Mapping | 
     if layout not in LAYOUTS:
         raise RecordingError(f"write_mat: layout {layout!r} is not one of {', '.join(LAYOUTS)}")
     t = _times(t_s)
+    if layout == "table":
+        _check_table_name(table_name)
     reserved = {"provenance"} | ({matlab_name(table_name), "time"} if layout == "table" else set())
     names = _identifiers(signals, reserved)
     columns = {names[k]: _column(k, v, t.size) for k, v in signals.items()}
@@ -127,6 +129,7 @@ def table_variables(columns: Mapping[str, np.ndarray], provenance: Mapping | Non
 
     if not isinstance(columns, Mapping) or not columns:
         raise RecordingError("write_mat: columns must be a non-empty dict of name -> values")
+    _check_table_name(table_name)
     names = _identifiers(columns, {"provenance", matlab_name(table_name)})
     n = {len(v) for v in columns.values()}
     if len(n) != 1:
@@ -142,6 +145,14 @@ def table_variables(columns: Mapping[str, np.ndarray], provenance: Mapping | Non
             fields[ident] = cells
     prov = _provenance({"smafinger_version": __version__, **dict(provenance or {})}, "provenance")
     return {matlab_name(table_name): fields, "provenance": prov}
+
+
+def _check_table_name(table_name: str) -> None:
+    """The table's struct cannot be named as the provenance struct beside it (it was written over,
+    a file with no data; found by an API fuzz)."""
+    if matlab_name(table_name) == "provenance":
+        raise RecordingError(f"write_mat: table_name {table_name!r} is the name of the provenance struct "
+                             "written beside the table; choose another")
 
 
 def save_mat(file: str | Path, mdict: dict) -> None:
