@@ -156,3 +156,13 @@ def test_bad_penalties_are_refused(kwargs, match):
     pytest.importorskip("gymnasium")
     with pytest.raises(ValueError, match=match):
         make_env(params="paper2010", **kwargs)
+
+
+def test_a_session_reads_its_initial_state_before_any_step_and_refuses_a_non_set():
+    """signal() before the first step raised AttributeError on the missing result, and
+    make_env(params=5) an AttributeError on .mechanism (found by an API fuzz)."""
+    s = PlantSession(episode_s=0.2)
+    first = s.observe()
+    assert s.signal("theta_deg") == first[0] and s.signal("duty_upper") == 0.0
+    with pytest.raises(TypeError, match="params = 5 is not a parameter set"):
+        make_env(params=5)

@@ -337,6 +337,11 @@ def test_map_twice_and_bad_dict_values_are_refused():
         parse_map_options(["duty=a", "duty=b"])
     with pytest.raises(MappingError, match="scale 'x' is not a number"):
         SignalMap.from_dict({"duty": ("u", "x")})
+    with pytest.raises(MappingError, match="scale True is not a number"):
+        SignalMap.from_dict({"duty": ("u", True)})
+    # numpy's numbers are numbers (np.float32 was refused; found by an API fuzz)
+    assert SignalMap.from_dict({"duty": ("u", np.int64(100))}).get("duty").scale == 100.0
+    assert SignalMap.from_dict({"duty": ("u", np.float32(0.5))}).get("duty").scale == 0.5
     with pytest.raises(MappingError, match="neither"):
         SignalMap.from_dict({"duty": 3})
 

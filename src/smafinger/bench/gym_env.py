@@ -47,6 +47,8 @@ class PlantSession:
                  overrides: tuple[str, ...] = ()):
         if isinstance(overrides, str) or not all(isinstance(o, str) for o in overrides):
             raise ValueError(f"overrides = {overrides!r} must be a list of NAME=VALUE strings")
+        if not isinstance(params, (str, ParameterSet)):
+            raise TypeError(f"params = {params!r} is not a parameter set or a set's name")
         p = get_params(params) if isinstance(params, str) else params
         self.params = p.with_overrides(list(overrides)) if overrides else p
         from ..engine.numerics import damping_rate_per_s, damping_step_limit, unstable_step
@@ -133,14 +135,21 @@ class PlantSession:
         return tuple(float(x) if k == keep else 0.0 for x, k in zip(d, self._directions)), True
 
     def signal(self, name: str) -> float:
-        """The last sample of an output signal (0 before the first step, except the initial state)."""
+        """The last sample of an output signal; before the first step, the initial state's (the
+        first sample of any run, at zero duty; it raised AttributeError, found by an API fuzz)."""
+        if self.result is None:
+            return float(self._initial().signal(name)[0])
         return float(self.result.signal(name)[-1])
+
+    def _initial(self):
+        """A run of one control interval at zero duty, whose first sample is the initial state."""
+        zero = VoltageProgram(((0.0,) + (0.0,) * len(self.wires),), "duty")
+        return run_spec(make_spec(self.params, "open-loop", voltage=zero, t_end_s=self.dt,
+                                  output_interval_s=self.dt, **BENCH_NUMERICS))
 
     def observe(self) -> np.ndarray:
         if self.result is None:  # the initial state: the first sample of any run (zero duty here)
-            zero = VoltageProgram(((0.0,) + (0.0,) * len(self.wires),), "duty")
-            probe = run_spec(make_spec(self.params, "open-loop", voltage=zero, t_end_s=self.dt,
-                                       output_interval_s=self.dt, **BENCH_NUMERICS))
+            probe = self._initial()
             first = {n: float(probe.signal(n)[0]) for n in probe.column_names}
             get = first.__getitem__
             rate = 0.0

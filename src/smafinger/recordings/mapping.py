@@ -22,6 +22,7 @@ import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from ..values import is_real
 from .signals import MAPPABLE, RecordingError
 
 
@@ -87,7 +88,7 @@ class SignalMap:
         for name, value in mapping.items():
             if isinstance(value, tuple) and len(value) == 2:
                 src, scale = value
-                if not isinstance(scale, (int, float)) or isinstance(scale, bool):
+                if not is_real(scale):  # numpy's numbers too (np.float32 was refused)
                     raise MappingError(f"mapping {name}: scale {scale!r} is not a number")
                 entries.append((name, Source(src, float(scale))))
             elif isinstance(value, str):
