@@ -299,3 +299,23 @@ def test_an_open_loop_run_reports_no_reach_and_no_overshoot():
     assert math.isnan(row["seg0_reached_s"]) and math.isnan(row["seg0_overshoot_m"])
     closed = simulate("linear-bias-spring", "cooperative", "0:0.004", t_end_s=6.0).summary()["segments"][0]
     assert closed["reached_s"] is not None and closed["overshoot_m"] is not None
+
+
+def test_the_public_helpers_on_edge_inputs():
+    """Found by an API fuzz: numpy's errors from inside, a division by zero, and an empty window
+    reported as settled at once."""
+    from smafinger.cycle_metrics import reduction
+
+    t, th, none = np.linspace(0.0, 1.0, 11), np.linspace(0.0, -10.0, 11), np.array([])
+    with pytest.raises(ValueError, match=r"t_off_s = 0.5 is before the first sample \(1 s\)"):
+        M.openloop_metrics(t + 1.0, th, 0.5)
+    with pytest.raises(ValueError, match=r"on_s\[0\] = \(5, 6\): no sample of the run \(0 to 1 s\)"):
+        M.onoff_cycle_metrics(t, th, t, t, t, [(5, 6)])
+    for call in (lambda: M.sample_at(none, none, 0.0), lambda: M.increase(none, none, 0.0, 1.0),
+                 lambda: M.run_metrics(none, none, [], {"u": none}, {"u": none}, {"u": none})):
+        with pytest.raises(ValueError, match="t has no samples"):
+            call()
+    assert reduction(0.0, 0.0) is None and reduction(10.0, 6.0) == pytest.approx(0.4)
+    assert M.settle_time(t, th, -10.0, 5.0, 6.0) is None  # no sample in [5, 6] s: was 0.0, "at once"
+    assert M.settle_time(t, th, -10.0, 0.0, 1.0) == pytest.approx(1.0)  # inside only at the last sample
+    assert M.rest_time(t, np.zeros_like(t), 5.0, 6.0) is None and M.rest_time(t, np.zeros_like(t), 0.0, 1.0) == 0.0

@@ -47,5 +47,6 @@ def reached_sum(segments: Sequence[Mapping], n_segments: int) -> float | None:
 
 
 def reduction(slower_s: float | None, faster_s: float | None) -> float | None:
-    """Relative time saved: ``(slower - faster) / slower``; ``None`` if either is missing."""
-    return None if slower_s is None or faster_s is None else (slower_s - faster_s) / slower_s
+    """Relative time saved: ``(slower - faster) / slower``; ``None`` if either is missing or the
+    slower one took no time (no relative saving; it divided by zero)."""
+    return None if slower_s is None or faster_s is None or slower_s == 0 else (slower_s - faster_s) / slower_s

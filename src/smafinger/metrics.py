@@ -101,7 +101,10 @@ def motion_start_s(t: np.ndarray, theta_deg: np.ndarray, threshold_deg: float = 
 
 def _inside_from(ts: np.ndarray, outside: np.ndarray, start_s: float) -> float | None:
     """Time from ``start_s`` after which ``outside`` stays false to the last sample ``ts``
-    (0 if never true; ``None`` if true at the last sample)."""
+    (0 if never true; ``None`` if true at the last sample, or if there is no sample: an empty
+    window had 0, "at once", found by an API fuzz)."""
+    if len(ts) == 0:
+        return None
     if not outside.any():
         return 0.0
     k = int(np.flatnonzero(outside)[-1])
@@ -114,7 +117,8 @@ def settle_time(t: np.ndarray, theta_deg: np.ndarray, target_deg: float, start_s
                 end_s: float, band_deg: float = SETTLE_BAND_DEG) -> float | None:
     """Time from ``start_s`` after which ``|theta - target| <= band_deg`` until ``end_s``.
 
-    0 if always inside; ``None`` if the joint is still outside at ``end_s``.
+    0 if always inside; ``None`` if the joint is still outside at ``end_s`` (or no sample
+    falls between ``start_s`` and ``end_s``).
     """
     m = window(t, start_s, end_s)
     return _inside_from(t[m], np.abs(theta_deg[m] - target_deg) > band_deg, start_s)
@@ -124,7 +128,8 @@ def rest_time(t: np.ndarray, speed: np.ndarray, start_s: float, end_s: float,
               threshold: float = REST_SPEED_DEG_S) -> float | None:
     """Time from ``start_s`` after which ``|speed| <= threshold`` until ``end_s`` (the joint at rest).
 
-    0 if it never moves faster; ``None`` if it is still moving at ``end_s``.
+    0 if it never moves faster; ``None`` if it is still moving at ``end_s`` (or no sample
+    falls between ``start_s`` and ``end_s``).
     """
     m = window(t, start_s, end_s)
     return _inside_from(t[m], np.abs(speed[m]) > threshold, start_s)
@@ -184,13 +189,21 @@ def cooled_time(t: np.ndarray, xi: Mapping[str, np.ndarray], start_s: float, end
     return max(times, default=0.0)
 
 
+def _some(t: np.ndarray) -> None:
+    """ValueError for signals with no sample (an IndexError came from inside; found by an API fuzz)."""
+    if len(t) == 0:
+        raise ValueError("t has no samples: the metrics need at least one")
+
+
 def sample_at(t: np.ndarray, x: np.ndarray, at_s: float) -> float:
     """``x`` at the first sample at or after ``at_s`` (the last sample if none)."""
+    _some(t)
     return float(x[min(int(np.searchsorted(t, at_s - EDGE_S)), len(t) - 1)])
 
 
 def increase(t: np.ndarray, cumulative: np.ndarray, start_s: float, end_s: float) -> float:
     """Increase of a cumulative signal (e.g. energy) from ``start_s`` to ``end_s``."""
+    _some(t)
     k0 = int(np.searchsorted(t, start_s - EDGE_S))
     k1 = min(int(np.searchsorted(t, end_s - EDGE_S)), len(t) - 1)
     return float(cumulative[k1] - cumulative[k0])
@@ -211,8 +224,11 @@ def openloop_metrics(t: np.ndarray, theta_deg: np.ndarray, t_off_s: float,
     ``return_start_s`` (moved ``move_deg`` back) and ``return90_s`` (covered ``fraction`` of
     the way from ``angle_at_off_deg`` to ``final_deg``).
     """
+    _some(t)
     d = np.abs(theta_deg - float(theta_deg[0]))
     heat = window(t, end_s=t_off_s)
+    if not heat.any():
+        raise ValueError(f"t_off_s = {t_off_s!r} is before the first sample ({float(t[0]):g} s): nothing was heated")
     cool = ~heat
     rng = float(np.max(d[heat]))
     k_off = int(np.flatnonzero(heat)[-1])
@@ -285,6 +301,9 @@ def onoff_cycle_metrics(t: np.ndarray, theta_deg: np.ndarray, T_wire_C: np.ndarr
         end = on_s[k + 1][0] if k + 1 < len(on_s) else float(t[-1])
         th0, th_off = sample_at(t, theta_deg, on), sample_at(t, theta_deg, off)
         heat, cool = window(t, on, off), window(t, off, end)
+        if not heat.any():
+            raise ValueError(f"on_s[{k}] = ({on!r}, {off!r}): no sample of the run ({float(t[0]):g} to "
+                             f"{float(t[-1]):g} s) falls in it")
         way = abs(th_off - th0)
         back = first_time(cool & (np.abs(theta_deg - th0) <= (1.0 - fraction) * way), t) if way > 0 else None
         mart = martensite_time(t, np.where(cool, xi, 0.0), off)
@@ -357,6 +376,7 @@ def run_metrics(t: np.ndarray, q: np.ndarray, spans: Sequence[Span],
                 heat_J: Mapping[str, np.ndarray] | None = None) -> dict:
     """Per-segment metrics, and each wire's energy (electrical, at its terminals; and the heat the
     model puts into it, if given), peak temperature and peak stress (cumulative energy signals)."""
+    _some(t)
     return {
         "segments": [segment_metrics(t, q, s, temperature_C, energy_J, unit, heat_J) for s in spans],
         "energy_J": {w: float(e[-1]) for w, e in energy_J.items()},
