@@ -209,6 +209,8 @@ def test_chunked_is_lazy_and_complete(n, size):
     ("tcp://127.0.0.1:http", r"port 'http' is not a number"),
     ("tcp://:8786", "the host is missing"),
     ("tcp://host:1/path", "expected an address like tcp://HOST:PORT"),
+    ("tcp://h:\u00b2", r"port '\u00b2' is not a number"),  # isdigit() but not int(): found by an API fuzz
+    ("tcp://" + "a" * 70 + ":8786", "host 'a{70}' is not a valid host name"),  # UnicodeError from IDNA
 ])
 def test_bad_scheduler_addresses_are_refused_at_once(address, message):
     with pytest.raises(batch.SchedulerError, match=message):

@@ -73,7 +73,7 @@ def parse_scheduler_address(address: str) -> tuple[str, str, int | None]:
         raise ValueError(f"--scheduler {address!r}: the host is missing (expected tcp://HOST:PORT)")
     port = None
     if port_text is not None:
-        if not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
+        if not (port_text.isascii() and port_text.isdigit()) or not 1 <= int(port_text) <= 65535:  # not '²'
             raise ValueError(f"--scheduler {address!r}: port {port_text!r} is not a number in 1..65535")
         port = int(port_text)
     return scheme, host, port
@@ -103,6 +103,8 @@ def check_scheduler(address: str, timeout_s: float = CONNECT_TIMEOUT_S) -> str:
     if scheme in ("tcp", "tls"):
         try:
             socket.create_connection((host, port), timeout=timeout_s).close()
+        except UnicodeError:  # a host name the IDNA codec refuses (a label over 63 characters)
+            raise SchedulerError(f"--scheduler {address!r}: host {host!r} is not a valid host name") from None
         except OSError as exc:
             reason = "no answer" if isinstance(exc, TimeoutError) else (exc.strerror or str(exc))
             raise SchedulerError(f"cannot connect to the Dask scheduler at {shown}: {reason}") from None
