@@ -1,6 +1,7 @@
 """Joint-level fit (Fig. 9): recovery of h0, h2, C_DF from synthetic curves, nonsmoothness."""
 
 import dataclasses
+import math
 import json
 
 import numpy as np
@@ -176,3 +177,27 @@ def test_a_curve_given_twice_or_copied_under_another_name_is_refused(tmp_path):
         assert len(r.stderr.strip().splitlines()) == 1
         assert f"{second}: the same data as {heat} (every sample equal)" in r.stderr, r.stderr
         assert not out.exists()
+
+
+def test_the_joint_fit_refuses_what_it_cannot_fit(tmp_path):
+    """Found by an API fuzz: a linear set was an internal error (exit 1), a sampling interval of
+    0 a ZeroDivisionError, and a NaN angle a fit reported as a success at its start values."""
+    from smafinger.analysis.data import AngleCurve, DataError
+    from smafinger.cli import main
+
+    heat = write_csv(tmp_path / "heat.csv", synthesize(TRUTH, "0:5:0", 2.0, SAMPLE_S))
+    cool = write_csv(tmp_path / "cool.csv", synthesize(TRUTH, "0:5:0,1:0:0", 2.0, SAMPLE_S))
+    assert main(["identify", "joint", "--heating", str(heat), "--cooling", str(cool), "--params",
+                 "linear-bias-spring", "--no-progress"]) == 2
+    with pytest.raises(ValueError, match="'linear-bias-spring' is a linear-bias-spring set"):
+        synthesize(get("linear-bias-spring"), "0:8", 1.0)
+    for kw, name in ((dict(sample_s=0.0), "sample_s = 0.0"), (dict(sample_s=-0.1), "sample_s = -0.1"),
+                     (dict(t_end_s=math.nan), "t_end_s = nan")):
+        with pytest.raises(ValueError, match=name):
+            synthesize(TRUTH, "0:5:0", **{"t_end_s": 2.0, **kw})
+    with pytest.raises(ValueError, match="t_s has no samples"):
+        simulate_angle(TRUTH, VoltageProgram.parse("0:5:0"), np.array([]))
+    with pytest.raises(DataError, match=r"sample 2 is not finite \(t = 0.2 s, angle = nan deg\)"):
+        AngleCurve("bench", np.array([0.0, 0.1, 0.2]), np.array([0.0, -1.0, np.nan]))
+    with pytest.raises(DataError, match="with samples"):
+        AngleCurve("bench", np.array([]), np.array([]))

@@ -252,6 +252,19 @@ class AngleCurve:
     angle_deg: np.ndarray
     voltage_V: np.ndarray | None = None
 
+    def __post_init__(self) -> None:
+        """A curve built in Python has samples, all finite (a NaN angle made every residual the
+        fit's failure value, and the fit reported success: found by an API fuzz). The file
+        readers say more, with the row."""
+        t, a = np.asarray(self.t_s), np.asarray(self.angle_deg)
+        if t.ndim != 1 or t.shape != a.shape or t.size == 0:
+            raise DataError(f"{self.path}: t_s and angle_deg must be 1-D arrays of one length, with samples "
+                            f"(shapes {t.shape} and {a.shape})")
+        bad = ~(np.isfinite(t) & np.isfinite(a))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            raise DataError(f"{self.path}: sample {k} is not finite (t = {float(t[k])!r} s, angle = {float(a[k])!r} deg)")
+
     @property
     def name(self) -> str:
         return Path(self.path).name

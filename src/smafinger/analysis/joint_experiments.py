@@ -15,6 +15,7 @@ import numpy as np
 from ..engine.run import DEFAULT_DT_S, make_spec, run_spec
 from ..parameters import ParameterSet
 from ..profiles import VoltageProgram
+from ..values import is_real
 from .data import AngleCurve, DataError
 
 OUTPUT_INTERVAL_S = 0.01
@@ -90,8 +91,19 @@ FIT_DT_S = DEFAULT_DT_S
 FIT_METHOD = "rk4"
 
 
+def joint_set(params: ParameterSet) -> None:
+    """ValueError unless ``params`` is a finger-joint set: the joint fit reads its angle and its
+    heating and cooling damping (a linear set was an internal error; found by an API fuzz)."""
+    if params.mechanism != "joint":
+        raise ValueError(f"identify joint fits a finger-joint set; {params.name!r} is a {params.mechanism} set "
+                         "(fit it with identify actuator)")
+
+
 def simulate_angle(params: ParameterSet, program: VoltageProgram, t_s: np.ndarray) -> np.ndarray:
-    """Model joint angle [deg] at the times ``t_s`` under an open-loop program."""
+    """Model joint angle [deg] at the times ``t_s`` (at least one) under an open-loop program."""
+    joint_set(params)
+    if len(t_s) == 0:
+        raise ValueError("t_s has no samples: the model's angle is read at one time at least")
     spec = make_spec(params, strategy="open-loop", voltage=program, t_end_s=_t_end(float(t_s[-1])),
                      output_interval_s=OUTPUT_INTERVAL_S, dt_s=FIT_DT_S, method=FIT_METHOD)
     r = run_spec(spec, engine="compiled", record="metrics")  # the angle is one of the metrics' signals
@@ -104,6 +116,9 @@ def synthesize(params: ParameterSet, program: VoltageProgram | str, t_end_s: flo
     """A synthetic measured curve: the model's angle every ``sample_s`` plus Gaussian noise."""
     if isinstance(program, str):
         program = VoltageProgram.parse(program)
+    for name, v in (("t_end_s", t_end_s), ("sample_s", sample_s)):
+        if not (is_real(v) and math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} = {v!r} must be a finite number > 0")
     n = int(round(t_end_s / sample_s))
     t = np.round(np.arange(n + 1) * sample_s, 9)
     th = simulate_angle(params, program, t)

@@ -20,7 +20,7 @@ from ..parameters import ParameterSet
 from ..profiles import VoltageProgram
 from .data import AngleCurve
 from .fit_uncertainty import null_directions
-from .joint_experiments import program_text
+from .joint_experiments import joint_set, program_text
 from .joint_objective import PhaseObjective
 
 PHASE_FIELDS = {
@@ -163,6 +163,7 @@ def _phase_start(phase: str, experiments: Sequence[tuple[AngleCurve, VoltageProg
         raise ValueError(f"phase = {phase!r} is not one of {', '.join(PHASE_FIELDS)}")
     if not experiments:
         raise ValueError(f"no {phase} curve to fit")
+    joint_set(base)
     fields = PHASE_FIELDS[phase] + ((MSF_FIELD,) if fit_msf else ())
     start = {}
     for f in fields:
