@@ -87,6 +87,8 @@ def test_a_tiny_tuning_end_to_end(tmp_path):
     # a field given with --set and tuned too: the JSON reported as fixed a value the search moved
     (["pid", "-t", "fig15-cycle", "--set", "K_P_per_q=3000", "-p", "K_P_per_q=1000:5000"],
      "K_P_per_q is both fixed (--set) and free (--param)"),
+    # a NaN limit turned the temperature limit off and wrote NaN into the JSON (found by an API fuzz)
+    (["pid", "-t", "fig15-cycle", "--max-peak-temperature-c", "nan"], "max_peak_T_C = nan must be a finite"),
 ])
 def test_tune_bad_input_is_one_line_exit_2(tmp_path, args, names):
     out = tmp_path / "never.json"
@@ -104,3 +106,21 @@ def test_tune_out_in_a_missing_folder_is_refused_before_the_tuning(tmp_path):
     assert r.exit_code == 2, r.output
     lines = [x for x in r.output.splitlines() if x.strip()]
     assert len(lines) == 1 and f"--out {out}: folder" in lines[0], lines
+
+
+def test_tune_in_python_refuses_what_it_cannot_search():
+    """Found by an API fuzz: budget 0 returned no values, popsize 1 and no free field failed inside
+    cma, and a gain of 0 on a log-scale box took log(0)."""
+    from smafinger.bench.tasks import select_tasks
+    from smafinger.bench.tune import FreeParam, tune
+    from smafinger.control.params import PaperPID
+
+    tasks = select_tasks(("linear-bias-spring",), ("sine-0.5hz",))
+    for kw, words in ((dict(budget=0), "budget = 0 must be a whole number >= 1"),
+                      (dict(popsize=1), "popsize = 1 must be a whole number >= 2"),
+                      (dict(max_peak_T_C=float("inf")), "max_peak_T_C = inf must be a finite"),
+                      (dict(free=[]), "free: no field to tune")):
+        with pytest.raises(ValueError, match=words):
+            tune(PaperPID(), tasks, **kw)
+    box = FreeParam("K_I_per_q_s", 1.0, 100.0, log=True)
+    assert box.position(0.0) == 0.0 and box.position(100.0) == pytest.approx(1.0)

@@ -32,6 +32,7 @@ from ..control.params import CONTROLLERS, ControllerParameters, PaperPID
 from ..engine.batch import make_pool, run_batch
 from ..model.build import build_model
 from ..parameters import ParameterError, ParameterSet
+from ..values import is_real, is_whole
 from .runner import BENCH_NUMERICS, OUTPUT_S, warm_kernels
 from .scores import record_of, task_scores
 from .tasks import Task
@@ -69,7 +70,11 @@ class FreeParam:
         return self.lo + u * (self.hi - self.lo)
 
     def position(self, v: float) -> float:
+        """The position of ``v`` in the box (below 0 or above 1 outside it; a value of 0 or less on
+        a log scale is at its low end: a valid gain of 0 took log(0))."""
         if self.log:
+            if v <= 0.0:
+                return 0.0
             return (math.log(v) - math.log(self.lo)) / (math.log(self.hi) - math.log(self.lo))
         return (v - self.lo) / (self.hi - self.lo)
 
@@ -186,6 +191,7 @@ def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "coo
 
     ``fixed``: fields given their values (``--set``): left out of the default free fields, and
     refused among explicit ones (the search would tune a value reported as fixed)."""
+    _check_search(budget, popsize, max_peak_T_C, free)
     say = report or (lambda msg: None)
     mechs = {t.mechanism for t in tasks}
     if len(mechs) != 1:
@@ -206,6 +212,23 @@ def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "coo
     warm_kernels(_specs(tasks[:1], [PaperPID(), base], strategy))  # compiled once here, loaded by the workers
     with make_pool(workers) as pool:
         return _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, pool, say)
+
+
+#: the smallest budget (evaluations) and population CMA-ES is run with (cma needs 2 weights)
+MIN_BUDGET, MIN_POPSIZE = 1, 2
+
+
+def _check_search(budget, popsize, max_peak_T_C, free) -> None:
+    """ValueError naming a search setting :func:`tune` cannot use (found by an API fuzz: a budget
+    of 0 returned no values, a NaN limit turned the temperature limit off, no free field divided
+    by zero inside cma)."""
+    for name, v, lo in (("budget", budget, MIN_BUDGET), ("popsize", popsize, MIN_POPSIZE)):
+        if not (is_whole(v) and v >= lo):
+            raise ValueError(f"{name} = {v!r} must be a whole number >= {lo}")
+    if max_peak_T_C is not None and not (is_real(max_peak_T_C) and math.isfinite(max_peak_T_C)):
+        raise ValueError(f"max_peak_T_C = {max_peak_T_C!r} must be a finite temperature in degC")
+    if free is not None and len(free) == 0:
+        raise ValueError("free: no field to tune (give one at least, or None for the default ones)")
 
 
 def _search(base, tasks, strategy, free, max_peak_T_C, budget, popsize, seed, pool, say) -> TuneResult:

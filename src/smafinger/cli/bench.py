@@ -135,7 +135,7 @@ def tune(
     violations and heat above the limit (docs/controllers.md, "Tuning").
     """
     from ..bench.runner import STRATEGIES
-    from ..bench.tune import FreeParam, task_measure
+    from ..bench.tune import MIN_BUDGET, MIN_POPSIZE, FreeParam, task_measure
     from ..bench.tune import tune as run_tune
     from ..control.params import CONTROLLERS, controller_from
     from ..engine.batch import BatchError
@@ -147,7 +147,7 @@ def tune(
         _fail(f"--mechanism {mechanism!r} is not one of {', '.join(MECHANISMS)}")
     if strategy not in STRATEGIES:
         _fail(f"--strategy {strategy!r} is not one of {', '.join(STRATEGIES)}")
-    for name, v, lo in (("--budget", budget, 1), ("--popsize", popsize, 2)):
+    for name, v, lo in (("--budget", budget, MIN_BUDGET), ("--popsize", popsize, MIN_POPSIZE)):
         if v < lo:
             _fail(f"{name} {v}: must be >= {lo}")
     if workers is not None and workers < 1:
@@ -172,9 +172,9 @@ def tune(
            "scores": res.scores, "reference": res.reference, "history": res.history,
            "command": "smafinger tune " + " ".join(sys.argv[2:] if len(sys.argv) > 2 else [controller])}
     if out is not None:  # before anything is printed: a closed stdout must not lose the gains
-        from ..files import atomic_write_text
+        from ..files import atomic_write_text, json_text
 
-        atomic_write_text(out, json.dumps(doc, indent=2, default=float) + "\n")
+        atomic_write_text(out, json_text(doc, digits=None))  # strict JSON: a non-finite number as null
     for t, s, r in zip(tasks, res.scores, res.reference):
         print(f"{t.name}: {task_measure(t, s):.4g} (paper's PID {task_measure(t, r):.4g}), "
               f"peak {s['peak_T_C']:.1f} degC (limit {res.max_peak_T_C:.1f}), "
