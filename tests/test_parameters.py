@@ -207,3 +207,17 @@ def test_a_given_length_taken_back_to_equilibrium_is_the_named_sets_and_a_record
     assert from_dict(ran, record=True).spring_length_upper_m == 0.0176  # as it ran: kept
     with pytest.raises(ParameterError, match="has no effect"):
         from_dict(ran)  # as a file's edit: refused
+
+
+def test_one_string_where_a_list_belongs_is_a_list_of_one():
+    """A string given where a list belongs was split into its letters: with_overrides("V_H_V=6")
+    read the override 'V', select_tasks("joint") the mechanism 'j' (found by an API fuzz)."""
+    from smafinger.bench.tasks import select_tasks
+    from smafinger.control.params import controller_from
+    from smafinger.paper.runner import select
+
+    p = get("paper2010")
+    assert p.with_overrides("V_H_V=6") == p.with_overrides(["V_H_V=6"]) and p.with_overrides("V_H_V=6").V_H_V == 6.0
+    assert controller_from("pid", "K_P_per_q=3").K_P_per_q == 3.0
+    assert select_tasks("joint") == select_tasks(("joint",))
+    assert [s.name for s in select("fig8-h0-60-upper-v1")] == ["fig8-h0-60-upper-v1"]

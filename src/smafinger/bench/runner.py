@@ -17,6 +17,7 @@ import pandas as pd
 from ..engine.batch import run_batch
 from ..engine.defaults import DEFAULT_DT_S, DEFAULT_METHOD, DEFAULT_PWM
 from ..engine.run import make_spec
+from ..values import one_or_many
 from .presets import BENCH_CONTROLLERS, bench_controller
 from .scores import RunRecord, bandwidth, record_of, task_scores
 from .tasks import Task
@@ -62,6 +63,7 @@ def run_bench(tasks: Sequence[Task], labels: Sequence[str] = BENCH_CONTROLLERS,
     ``pool`` (:mod:`smafinger.engine.pools`) if given, else on ``workers`` processes.
     ``on_progress(done, total)``: as the runs finish (:func:`~smafinger.engine.batch.run_batch`)."""
     say = report or (lambda msg: None)
+    labels, strategies = one_or_many(labels), one_or_many(strategies)
     bad = [s for s in strategies if s not in STRATEGIES]
     if bad:
         raise ValueError(f"strategy {bad[0]!r} is not one of {', '.join(STRATEGIES)}")

@@ -17,6 +17,7 @@ from ..paper.scenario import MOVE_S, PAPER_FRICTION
 from ..paper.sec4 import FIG13_KINDS, KINDS, REST_DEG
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
+from ..values import one_or_many
 
 #: sine references are sampled into profile segments this often [s]
 SINE_SAMPLE_S = 0.05
@@ -138,7 +139,8 @@ QUICK_TASKS = (("joint", "fig12-extension"), ("linear-bias-spring", "step-10mm")
 def select_tasks(mechanisms: tuple[str, ...] = ("joint", "linear-bias-spring"),
                  names: tuple[str, ...] = (), quick: bool = False) -> tuple[Task, ...]:
     """The tasks of some mechanisms, optionally only those named (an unknown name is an error),
-    or only the :data:`QUICK_TASKS` among them."""
+    or only the :data:`QUICK_TASKS` among them (one name is a tuple of one)."""
+    mechanisms, names = one_or_many(mechanisms), one_or_many(names)
     unknown = sorted(set(mechanisms) - set(MECHANISM_SETS))
     if unknown:
         raise ValueError(f"mechanism {unknown[0]!r} is not one of {', '.join(MECHANISM_SETS)}")

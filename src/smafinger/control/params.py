@@ -19,6 +19,7 @@ from typing import Any, ClassVar
 
 from ..model.records import Controller
 from ..parameters.base import ParameterSet, checked_real
+from ..values import one_or_many
 from ..parameters.errors import ParameterError
 from .calibration import ResistanceCalibration, calibrate
 from .chain import NO_SHAPING, ControlChain, Estimator, Law, PIDGains
@@ -83,7 +84,7 @@ class ControllerParameters:
     def with_overrides(self, assignments: list[str] | tuple[str, ...]) -> "ControllerParameters":
         """Apply ``NAME=VALUE`` strings (``--controller-set``)."""
         changes: dict[str, Any] = {}
-        for a in assignments:
+        for a in one_or_many(assignments):
             if "=" not in a:
                 raise ParameterError(f"controller override {a!r} is not of the form NAME=VALUE")
             key, raw = (s.strip() for s in a.split("=", 1))

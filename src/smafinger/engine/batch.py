@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
+from ..values import one_or_many
 from .dask_pool import DaskPool, check_scheduler  # noqa: F401 (distributed itself is imported on use)
 from .pools import (CONNECT_TIMEOUT_S, BatchError, DistributedMissing, LocalPool, SchedulerError,  # noqa: F401
                     SerialPool, Task, available_cores, build_spec, is_warm, make_pool, run_chunk, start_forkserver,
@@ -66,9 +66,9 @@ def specs_product(params: Iterable = ("paper2010",), profiles: Iterable | None =
     name, a path, a set, a profile text or object). ``common`` holds the other
     :func:`make_spec` arguments (strategy, t_end_s, ...).
     """
-    params = _each(params)
-    second = [("profile", p) for p in _each(profiles)] if profiles is not None else []
-    second += [("voltage", v) for v in _each(voltages)] if voltages is not None else []
+    params = one_or_many(params)
+    second = [("profile", p) for p in one_or_many(profiles)] if profiles is not None else []
+    second += [("voltage", v) for v in one_or_many(voltages)] if voltages is not None else []
     if not second:
         second = [(None, None)]
     specs = []
@@ -79,14 +79,6 @@ def specs_product(params: Iterable = ("paper2010",), profiles: Iterable | None =
                 kw[name] = value
             specs.append(make_spec(params=p, **kw))
     return specs
-
-
-def _each(values) -> list:
-    """``values`` as a list; one value (text, a path, or anything not iterable) as a list of it
-    (``specs_product("paper2010")`` ran over the name's letters)."""
-    if isinstance(values, (str, bytes, os.PathLike)) or not isinstance(values, Iterable):
-        return [values]
-    return list(values)
 
 
 def chunked(tasks: Iterable, size: int) -> Iterator[list]:

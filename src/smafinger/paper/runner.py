@@ -31,6 +31,7 @@ from ..engine.run import RunSpec
 from ..files import JSON_DIGITS, json_ready, write_json  # noqa: F401  (json_ready re-exported)
 from ..outdir import STAGE_PREFIX, OwnFiles  # noqa: F401  (STAGE_PREFIX re-exported)
 from ..results import SimulationResult
+from ..values import one_or_many
 from . import investigation as inv
 from . import scenarios as scn
 from .claim import Outcome
@@ -94,7 +95,7 @@ def select(only: Iterable[str] | None) -> list[scn.Scenario]:
     if not only:
         return scn.all_scenarios()
     chosen: list[str] = []
-    for pat in only:
+    for pat in one_or_many(only):
         if any(c in pat for c in "*?["):
             hits = [n for n in scn.names() if fnmatch.fnmatchcase(n, pat)]
             if not hits:

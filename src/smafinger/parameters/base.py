@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
-from ..values import is_real
+from ..values import is_real, one_or_many
 from .errors import ParameterError
 from .options import OPTION_NAMES, OPTION_TYPES, ModelOptions, parse_option
 
@@ -169,7 +169,7 @@ class ParameterSet:
     def with_overrides(self, assignments: list[str] | tuple[str, ...]) -> "ParameterSet":
         """Apply ``NAME=VALUE`` strings (as given with ``--set``)."""
         changes: dict[str, Any] = {}
-        for a in assignments:
+        for a in one_or_many(assignments):
             if "=" not in a:
                 raise ParameterError(f"override {a!r} is not of the form NAME=VALUE")
             key, raw = (s.strip() for s in a.split("=", 1))
