@@ -45,6 +45,7 @@ def test_later_overrides_win():
     (dict(T_init_C=math.nan), "override T_init_C = nan: not a finite number"),
     (dict(controller_in_cooling=1), "override controller_in_cooling = 1: not a bool"),
     (dict(tol_deg=True), "override tol_deg = True: not a finite number"),
+    (dict(T_init_C=10 ** 400), "override T_init_C = 1000000000000000000000000000000000000000: not a finite"),
 ])
 def test_bad_overrides_name_the_field_and_the_value(bad, match):
     with pytest.raises(ParameterError, match=match):
@@ -350,3 +351,11 @@ def test_the_report_says_which_investigation_runs_failed():
     note = "\n".join(failed_runs_note(runs))
     assert note.startswith("**1 run(s) failed: cycle:tamb60:fig15-independent-v2.**") and "`never`" in note
     assert failed_runs_note({"a": SimpleNamespace(ok=True)}) == []
+
+
+def test_numpy_numbers_are_overrides_too():
+    """np.float32 and np.int64 were refused as 'not a finite number' (found by an API fuzz)."""
+    import numpy as np
+
+    assert Overrides.of(T_init_C=np.float32(60.0)) == Overrides.of(T_init_C=60.0)
+    assert dict(Overrides.of(T_init_C=np.int64(60)).params)["T_init_C"] == 60.0

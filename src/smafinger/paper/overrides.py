@@ -23,6 +23,7 @@ from typing import Any, Iterable
 from ..parameters import MECHANISMS, ParameterError, ParameterSet
 from ..parameters.base import parse_value
 from ..parameters.options import OPTION_NAMES, OPTION_TYPES, parse_option
+from ..values import is_real
 
 #: run settings an override may change (``make_spec`` arguments), with their types
 RUN_SETTINGS: dict[str, type] = {
@@ -45,10 +46,14 @@ _FIELD_TYPES = _field_types()
 
 def _check(name: str, value: Any, kind: type) -> Any:
     """``value`` as ``kind`` (an int is a float); ``ParameterError`` naming the field otherwise."""
-    if kind is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ParameterError(f"override {name} = {value!r}: not a finite number")
-        return float(value)
+    if kind is float:  # numpy's numbers too; an int beyond any float is not finite (found by an API fuzz)
+        try:
+            x = float(value) if is_real(value) else math.nan
+        except OverflowError:
+            x = math.inf
+        if not math.isfinite(x):
+            raise ParameterError(f"override {name} = {value!r:.40}: not a finite number")
+        return x
     if not isinstance(value, kind):
         raise ParameterError(f"override {name} = {value!r}: not a {kind.__name__}")
     return value
