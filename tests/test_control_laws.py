@@ -113,3 +113,22 @@ def test_a_microsecond_pwm_period_calibrates_with_the_averaged_pwm(monkeypatch):
     # the paper's sets keep their calibrations; a hysteresis rule that follows the ripple keeps the PWM resolved
     assert calibration.calibration_numerics(get("paper2010")).pwm == "exact"
     assert calibration.calibration_numerics(get("authors2020").replace(pwm_period_s=1e-6)).pwm == "exact"
+
+
+def test_a_calibration_estimates_only_what_it_can():
+    """Found by an API fuzz: one wire's 1-D series gave one estimate, a short row an IndexError,
+    and one target fitted a cubic to one position (a 1.3 um fit, metres off elsewhere)."""
+    from smafinger.control.calibration import ResistanceCalibration, calibrate
+    from smafinger.parameters import ParameterError
+
+    one = ResistanceCalibration(wires=("wire",), R_ref_ohm=(10.0,), c0=0.0, c1=(1.0,), c2=(0.0,), c3=(0.0,),
+                                rms_error=0.0, max_error=0.0)
+    np.testing.assert_allclose(one.estimate(np.array([10.0, 11.0, 12.0])), [0.0, 0.1, 0.2])
+    two = ResistanceCalibration(wires=("upper", "lower"), R_ref_ohm=(10.0, 10.0), c0=0.0, c1=(1.0, -1.0),
+                                c2=(0.0, 0.0), c3=(0.0, 0.0), rms_error=0.0, max_error=0.0)
+    np.testing.assert_allclose(two.estimate(np.array([11.0, 10.0])), [0.1])  # one sample of both wires
+    with pytest.raises(ParameterError, match=r"R_ohm has shape \(1, 1\); expected samples x 2 wire\(s\)"):
+        two.estimate(np.array([[11.0]]))
+    for targets in ((), (0.0075,), (0.004, 0.004, 0.008)):
+        with pytest.raises(ParameterError, match="needs 4 distinct positions at least"):
+            calibrate(get("linear-bias-spring"), targets)

@@ -32,6 +32,7 @@ import numpy as np
 
 from ..parameters.base import ParameterSet
 from ..parameters.errors import ParameterError
+from ..values import is_real, one_or_many
 
 #: calibration targets, in the mechanism's user unit: each is a step from rest, then held
 CALIBRATION_TARGETS = {
@@ -76,7 +77,7 @@ class ResistanceCalibration:
         for name in ("R_ref_ohm", "c0", "c1", "c2", "c3", "rms_error", "max_error"):
             v = getattr(self, name)
             for x in v if isinstance(v, tuple) else (v,):
-                if isinstance(x, bool) or not isinstance(x, (int, float)) or not np.isfinite(x):
+                if not is_real(x) or not np.isfinite(x):
                     raise ParameterError(f"calibration: {name} = {v!r} holds {x!r}, not a finite number")
         if not all(R > 0.0 for R in self.R_ref_ohm):
             raise ParameterError(f"calibration: R_ref_ohm = {self.R_ref_ohm!r} must be above 0 ohm")
@@ -85,8 +86,14 @@ class ResistanceCalibration:
                                  "must be at least 0")
 
     def estimate(self, R_ohm: np.ndarray) -> np.ndarray:
-        """q_hat for resistances ``R_ohm`` (samples x wires)."""
-        R = np.atleast_2d(np.asarray(R_ohm, dtype=float))
+        """q_hat for resistances ``R_ohm`` (samples x wires; for one wire a 1-D series of samples,
+        for several a 1-D array is one sample)."""
+        R = np.asarray(R_ohm, dtype=float)
+        if R.ndim == 1:
+            R = R[:, None] if len(self.wires) == 1 else R[None, :]
+        if R.ndim != 2 or R.shape[1] != len(self.wires):  # a short row was an IndexError (found by an API fuzz)
+            raise ParameterError(f"calibration: R_ohm has shape {np.shape(R_ohm)}; expected samples x "
+                                 f"{len(self.wires)} wire(s) ({', '.join(self.wires)})")
         q = np.full(R.shape[0], self.c0)
         for i in range(len(self.wires)):
             r = R[:, i] / self.R_ref_ohm[i] - 1.0
@@ -151,7 +158,10 @@ def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strateg
     :data:`EXACT_PWM_MIN_PERIOD_S` and averaging it is valid."""
     from ..engine.run import simulate
 
-    targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else targets
+    targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else tuple(one_or_many(targets))
+    if len(set(targets)) < DEGREE + 1:  # one target fitted a cubic to one position (found by an API fuzz)
+        raise ParameterError(f"calibration: targets = {targets!r}: the cubic map (Eq. S1) needs {DEGREE + 1} "
+                             "distinct positions at least")
     num = calibration_numerics(p)
     coord = f"{p.coordinate.name}_{p.coordinate.unit}"
     qs, Rs, R_ref = [], [], None
