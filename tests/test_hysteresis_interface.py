@@ -178,7 +178,7 @@ def test_bad_arguments_name_the_field_and_value():
         xi_history([1.0, 2.0], [0.0, 0.0], PAPER, xi_init=1.5)
     with pytest.raises(ValueError, match="sigma has a non-finite sample at index 1"):
         xi_history([1.0, 2.0], [0.0, np.inf], PAPER)
-    with pytest.raises(ValueError, match="reversal_C = 0.0 must be > 0"):
+    with pytest.raises(ValueError, match="reversal_C = 0.0 must be a finite number > 0"):
         xi_history([1.0, 2.0], [0.0, 0.0], PAPER, rule="deadband", reversal_C=0.0)
 
 
@@ -192,3 +192,22 @@ def test_max_loop_stress():
     T = 59.5 + 1.1 * s / 8e6  # above s: tau_M = 59.5 (g_M = 1) while tau_A = 76 (g_A < 1)
     gM, gA = major_loop(T, 1.1 * s, m)
     assert gM == 1.0 > gA
+
+
+def test_the_documented_entry_points_name_what_they_refuse():
+    """Found by an API fuzz: a parameter set given as the material reached numba's typing (pages
+    of compiler text), an infinite dead band never transformed, and an int beyond any float was
+    an OverflowError where the docstring promised a ValueError naming the field."""
+    from smafinger.model.hysteresis import kinetics_material, material_from_parameters
+    from smafinger.model.hysteresis_drive import xi_history
+    from smafinger.parameters import get
+
+    T, sigma = np.linspace(20.0, 120.0, 50), np.zeros(50)
+    with pytest.raises(TypeError, match="material = JointParameters: give a KineticsMaterial"):
+        xi_history(T, sigma, get("paper2010"))
+    m = material_from_parameters(get("paper2010"))
+    with pytest.raises(ValueError, match="reversal_C = inf must be a finite number > 0"):
+        xi_history(T, sigma, m, rule="deadband", reversal_C=float("inf"))
+    assert xi_history(T, sigma, m, rule="deadband").xi[-1] == 0.0  # heated through the band: austenite
+    with pytest.raises(ValueError, match="A_S0_C = inf is not a finite number"):
+        kinetics_material(10 ** 400, 110.0, 85.0, 60.0, 1e7, 1e7)

@@ -104,6 +104,15 @@ class BranchRecord(NamedTuple):
     merges: int
 
 
+def _float(v) -> float:
+    """``v`` as a float; an int beyond any float as inf, which the check then names (it was an
+    OverflowError; found by an API fuzz)."""
+    try:
+        return float(v)
+    except OverflowError:
+        return math.inf
+
+
 def kinetics_material(A_S0_C, A_F0_C, M_S0_C, M_F0_C, c_A_Pa_per_C, c_M_Pa_per_C):
     """A validated :class:`KineticsMaterial` (floats).
 
@@ -113,8 +122,8 @@ def kinetics_material(A_S0_C, A_F0_C, M_S0_C, M_F0_C, c_A_Pa_per_C, c_M_Pa_per_C
         Naming the field and value, unless A_F0 > A_S0, M_S0 > M_F0, A_S0 > M_F0,
         A_F0 > M_S0 (the major loop is not empty at zero stress) and c_A, c_M > 0.
     """
-    m = KineticsMaterial(*(float(v) for v in (A_S0_C, A_F0_C, M_S0_C, M_F0_C, c_A_Pa_per_C,
-                                             c_M_Pa_per_C)))
+    m = KineticsMaterial(*(_float(v) for v in (A_S0_C, A_F0_C, M_S0_C, M_F0_C, c_A_Pa_per_C,
+                                              c_M_Pa_per_C)))
     for name in m._fields:
         if not math.isfinite(getattr(m, name)):
             raise ValueError(f"{name} = {getattr(m, name)} is not a finite number")

@@ -9,13 +9,14 @@ and xi[k] is evaluated with the updated record (as the engine samples its output
 update: it shows what the engine's right-hand side sees inside a sub-step.
 """
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 
 from ..jit import njit
 from .hysteresis import (
-    AUTHORS2020, DEADBAND, DEFAULT_CAPACITY, DEFAULT_RULE, drive_direction, initial_record,
+    AUTHORS2020, DEADBAND, DEFAULT_CAPACITY, DEFAULT_RULE, KineticsMaterial, drive_direction, initial_record,
     new_stack, rule_code, update_memory, xi_on_branch,
 )
 
@@ -67,6 +68,9 @@ def xi_history(T, sigma, material, xi_init=1.0, rule=DEFAULT_RULE, reversal_C=No
     HistoryResult
     """
     code = rule_code(rule)
+    if not isinstance(material, KineticsMaterial):  # a parameter set reached numba's typing (found by an API fuzz)
+        raise TypeError(f"material = {type(material).__name__}: give a KineticsMaterial "
+                        "(kinetics_material(...), or material_from_parameters(a parameter set))")
     T = np.ascontiguousarray(T, dtype=np.float64)
     sigma = np.ascontiguousarray(sigma, dtype=np.float64)
     if T.ndim != 1 or T.shape != sigma.shape or T.size == 0:
@@ -80,8 +84,8 @@ def xi_history(T, sigma, material, xi_init=1.0, rule=DEFAULT_RULE, reversal_C=No
         raise ValueError(f"xi_init = {xi_init} is not in [0, 1]")
     if reversal_C is None:
         reversal_C = 0.5 if code == DEADBAND else 0.0
-    if code == DEADBAND and not reversal_C > 0.0:
-        raise ValueError(f"reversal_C = {reversal_C} must be > 0 for the deadband rule")
+    if code == DEADBAND and not (reversal_C > 0.0 and math.isfinite(reversal_C)):  # inf never transformed
+        raise ValueError(f"reversal_C = {reversal_C} must be a finite number > 0 for the deadband rule")
     if code == AUTHORS2020 and reversal_C != 0.0:
         raise ValueError(f"reversal_C = {reversal_C} must be 0 for the authors2020 rule")
     stack = new_stack(capacity)
