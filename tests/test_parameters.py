@@ -221,3 +221,16 @@ def test_one_string_where_a_list_belongs_is_a_list_of_one():
     assert controller_from("pid", "K_P_per_q=3").K_P_per_q == 3.0
     assert select_tasks("joint") == select_tasks(("joint",))
     assert [s.name for s in select("fig8-h0-60-upper-v1")] == ["fig8-h0-60-upper-v1"]
+
+
+def test_a_parameter_file_of_changes_writes_an_option_by_its_label(tmp_path):
+    """overrides_toml wrote an option member as a float ('stress_law = 0.0'), which the loader
+    refuses (found by an API fuzz)."""
+    from smafinger.parameters import resolve
+    from smafinger.parameters.files import overrides_toml
+    from smafinger.parameters.options import StressLaw
+
+    path = tmp_path / "changed.toml"
+    path.write_text(overrides_toml("paper2010", {"stress_law": StressLaw.ALGEBRAIC, "T_init_C": 30}, "a test"))
+    q = resolve(str(path))
+    assert q.options.stress_law == StressLaw.ALGEBRAIC and q.T_init_C == 30.0

@@ -49,8 +49,16 @@ def overrides_toml(base: str, changes: dict[str, Any], comment: str) -> str:
     """A parameter file starting from the named set ``base`` with ``changes`` (``name``,
     ``source``, fields, options), in the order given; ``comment`` is its first line."""
     lines = [f"# {comment}", f"base = {_toml_value(base)}"]
-    lines += [f"{k} = {_toml_value(v if isinstance(v, (bool, str)) else float(v))}" for k, v in changes.items()]
+    lines += [f"{k} = {_toml_value(_plain(v))}" for k, v in changes.items()]
     return "\n".join(lines) + "\n"
+
+
+def _plain(v: Any) -> Any:
+    """A change as the file writes it: text and bools as given, an option by its label (a member
+    was written as a float the loader refuses; found by an API fuzz), numbers as floats."""
+    if isinstance(v, (bool, str)):
+        return v
+    return v.label if hasattr(v, "label") else float(v)
 
 
 def load_toml(path: str | Path, registry_get: Callable[[str], ParameterSet]) -> ParameterSet:
