@@ -88,7 +88,7 @@ def test_a_tiny_tuning_end_to_end(tmp_path):
     (["pid", "-t", "fig15-cycle", "--set", "K_P_per_q=3000", "-p", "K_P_per_q=1000:5000"],
      "K_P_per_q is both fixed (--set) and free (--param)"),
     # a NaN limit turned the temperature limit off and wrote NaN into the JSON (found by an API fuzz)
-    (["pid", "-t", "fig15-cycle", "--max-peak-temperature-c", "nan"], "max_peak_T_C = nan must be a finite"),
+    (["pid", "-t", "fig15-cycle", "--max-peak-temperature-c", "nan"], "--max-peak-temperature-c nan: must be a finite"),
 ])
 def test_tune_bad_input_is_one_line_exit_2(tmp_path, args, names):
     out = tmp_path / "never.json"
@@ -124,3 +124,22 @@ def test_tune_in_python_refuses_what_it_cannot_search():
             tune(PaperPID(), tasks, **kw)
     box = FreeParam("K_I_per_q_s", 1.0, 100.0, log=True)
     assert box.position(0.0) == 0.0 and box.position(100.0) == pytest.approx(1.0)
+
+
+def test_tune_reads_one_fixed_name_as_one(monkeypatch):
+    """tune(fixed="K_P_per_q") tuned K_P_per_q: the string was a set of letters (found by review)."""
+    from smafinger.bench import tune as tune_module
+    from smafinger.bench.tasks import select_tasks
+    from smafinger.control.params import PaperPID
+
+    searched = []
+    monkeypatch.setattr(tune_module, "_search", lambda base, tasks, strategy, free, *a: searched.append(
+        [f.name for f in free]))
+    monkeypatch.setattr(tune_module, "warm_kernels", lambda specs: None)
+    tasks = select_tasks(("linear-bias-spring",), ("sine-0.5hz",))
+    tune_module.tune(PaperPID(), tasks, fixed="K_P_per_q", workers=1)
+    tune_module.tune(PaperPID(), tasks, fixed=["K_P_per_q"], workers=1)
+    assert searched[0] == searched[1] and "K_P_per_q" not in searched[0]
+    with pytest.raises(ValueError, match="K_P_per_q is both fixed"):
+        tune_module.tune(PaperPID(), tasks, fixed="K_P_per_q", free=[tune_module.FreeParam("K_P_per_q", 1.0, 2.0)])
+    assert select_tasks(("joint",), None) == select_tasks(("joint",), ())  # None: every task, as before

@@ -129,6 +129,9 @@ def test_a_calibration_estimates_only_what_it_can():
     np.testing.assert_allclose(two.estimate(np.array([11.0, 10.0])), [0.1])  # one sample of both wires
     with pytest.raises(ParameterError, match=r"R_ohm has shape \(1, 1\); expected samples x 2 wire\(s\)"):
         two.estimate(np.array([[11.0]]))
+    np.testing.assert_allclose(one.estimate(10.5), [0.05])  # one sample of one wire
     for targets in ((), (0.0075,), (0.004, 0.004, 0.008)):
-        with pytest.raises(ParameterError, match="needs 4 distinct positions at least"):
+        with pytest.raises(ParameterError, match="has 4 coefficients and needs 4 distinct positions at least"):
             calibrate(get("linear-bias-spring"), targets)
+    with pytest.raises(ParameterError, match=r"of 2 wire\(s\) has 7 coefficients"):  # 4 fitted the joint exactly
+        calibrate(get("paper2010"), (-34.0, -32.0, -30.0, -28.0))

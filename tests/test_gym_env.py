@@ -55,7 +55,7 @@ def test_bad_duties_name_the_wire_and_value(duties, names):
     ({"target": float("nan")}, "target = nan"),  # every reward NaN
     ({"target": 1e6}, "target = 1000000.0 must be a finite number within"),
     ({"temperature_sensors": "no"}, "temperature_sensors = 'no'"),  # turned the sensors on
-    ({"overrides": "V_H_V=9"}, "list of NAME=VALUE"),
+    ({"overrides": ["V_H_V=9", 9.0]}, "list of NAME=VALUE"),
 ])
 def test_bad_session_settings_name_the_field_and_value(kwargs, match):
     """Each was accepted and silently misread, or refused naming something else (found by review)."""

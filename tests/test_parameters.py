@@ -220,6 +220,9 @@ def test_one_string_where_a_list_belongs_is_a_list_of_one():
     assert p.with_overrides("V_H_V=6") == p.with_overrides(["V_H_V=6"]) and p.with_overrides("V_H_V=6").V_H_V == 6.0
     assert controller_from("pid", "K_P_per_q=3").K_P_per_q == 3.0
     assert select_tasks("joint") == select_tasks(("joint",))
+    from smafinger.paper.overrides import Overrides
+
+    assert Overrides.coerce("T_init_C=40") == Overrides.coerce(["T_init_C=40"])  # one rule everywhere
     assert [s.name for s in select("fig8-h0-60-upper-v1")] == ["fig8-h0-60-upper-v1"]
 
 

@@ -203,7 +203,7 @@ def _read_errors() -> tuple[type[BaseException], ...]:
     from scipy.io.matlab import MatReadError
 
     return (OSError, ValueError, KeyError, TypeError, IndexError, UnicodeDecodeError, MatReadError,
-            pyarrow.ArrowException, zlib.error, NameError)
+            pyarrow.ArrowException, zlib.error, UnboundLocalError)
 
 
 def _mat_provenance(path: Path) -> dict:

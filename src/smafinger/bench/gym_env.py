@@ -35,7 +35,7 @@ from ..model.build import build_model
 from ..parameters import ParameterSet
 from ..parameters import get as get_params
 from ..profiles import VoltageProgram
-from ..values import is_real
+from ..values import is_real, one_or_many
 from .runner import BENCH_NUMERICS
 
 
@@ -45,7 +45,8 @@ class PlantSession:
     def __init__(self, params: str | ParameterSet = "paper2010", target: float | None = None,
                  control_interval_s: float = 0.1, episode_s: float = 20.0, temperature_sensors: bool = False,
                  overrides: tuple[str, ...] = ()):
-        if isinstance(overrides, str) or not all(isinstance(o, str) for o in overrides):
+        overrides = tuple(one_or_many(overrides))  # one string is a list of one
+        if not all(isinstance(o, str) for o in overrides):
             raise ValueError(f"overrides = {overrides!r} must be a list of NAME=VALUE strings")
         if not isinstance(params, (str, ParameterSet)):
             raise TypeError(f"params = {params!r} is not a parameter set or a set's name")

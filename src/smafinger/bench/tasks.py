@@ -140,7 +140,7 @@ def select_tasks(mechanisms: tuple[str, ...] = ("joint", "linear-bias-spring"),
                  names: tuple[str, ...] = (), quick: bool = False) -> tuple[Task, ...]:
     """The tasks of some mechanisms, optionally only those named (an unknown name is an error),
     or only the :data:`QUICK_TASKS` among them (one name is a tuple of one)."""
-    mechanisms, names = one_or_many(mechanisms), one_or_many(names)
+    mechanisms, names = one_or_many(mechanisms), one_or_many(names or ())  # None or (): every task
     unknown = sorted(set(mechanisms) - set(MECHANISM_SETS))
     if unknown:
         raise ValueError(f"mechanism {unknown[0]!r} is not one of {', '.join(MECHANISM_SETS)}")

@@ -32,7 +32,7 @@ from ..control.params import CONTROLLERS, ControllerParameters, PaperPID
 from ..engine.batch import make_pool, run_batch
 from ..model.build import build_model
 from ..parameters import ParameterError, ParameterSet
-from ..values import is_real, is_whole
+from ..values import is_real, is_whole, one_or_many
 from .runner import BENCH_NUMERICS, OUTPUT_S, warm_kernels
 from .scores import record_of, task_scores
 from .tasks import Task
@@ -192,6 +192,7 @@ def tune(base: ControllerParameters, tasks: Sequence[Task], strategy: str = "coo
     ``fixed``: fields given their values (``--set``): left out of the default free fields, and
     refused among explicit ones (the search would tune a value reported as fixed)."""
     _check_search(budget, popsize, max_peak_T_C, free)
+    fixed = one_or_many(fixed)  # one name is a list of one (its letters were 'fixed': found by review)
     say = report or (lambda msg: None)
     mechs = {t.mechanism for t in tasks}
     if len(mechs) != 1:

@@ -11,6 +11,7 @@ Exit status: 0 done; 2 bad input (one line naming the option and the value, noth
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 from typing import List, Optional
@@ -150,6 +151,8 @@ def tune(
     for name, v, lo in (("--budget", budget, MIN_BUDGET), ("--popsize", popsize, MIN_POPSIZE)):
         if v < lo:
             _fail(f"{name} {v}: must be >= {lo}")
+    if max_peak_temperature_c is not None and not math.isfinite(max_peak_temperature_c):
+        _fail(f"--max-peak-temperature-c {max_peak_temperature_c}: must be a finite temperature in degC")
     if workers is not None and workers < 1:
         _fail(f"--workers {workers}: must be >= 1")
     if out is not None:  # refused before the tuning, not after it

@@ -89,7 +89,9 @@ class ResistanceCalibration:
         """q_hat for resistances ``R_ohm`` (samples x wires; for one wire a 1-D series of samples,
         for several a 1-D array is one sample)."""
         R = np.asarray(R_ohm, dtype=float)
-        if R.ndim == 1:
+        if R.ndim == 0:  # one sample of one wire
+            R = R.reshape(1, 1)
+        elif R.ndim == 1:
             R = R[:, None] if len(self.wires) == 1 else R[None, :]
         if R.ndim != 2 or R.shape[1] != len(self.wires):  # a short row was an IndexError (found by an API fuzz)
             raise ParameterError(f"calibration: R_ohm has shape {np.shape(R_ohm)}; expected samples x "
@@ -159,9 +161,10 @@ def calibrate(p: ParameterSet, targets: tuple[float, ...] | None = None, strateg
     from ..engine.run import simulate
 
     targets = CALIBRATION_TARGETS[p.mechanism] if targets is None else tuple(one_or_many(targets))
-    if len(set(targets)) < DEGREE + 1:  # one target fitted a cubic to one position (found by an API fuzz)
-        raise ParameterError(f"calibration: targets = {targets!r}: the cubic map (Eq. S1) needs {DEGREE + 1} "
-                             "distinct positions at least")
+    needed = 1 + DEGREE * len(p.wire_names)  # Eq. (S1)'s coefficients (found by an API fuzz and review:
+    if len(set(targets)) < needed:         # one target, or 4 on the joint's two wires, fitted exactly)
+        raise ParameterError(f"calibration: targets = {targets!r}: the cubic map (Eq. S1) of {len(p.wire_names)} "
+                             f"wire(s) has {needed} coefficients and needs {needed} distinct positions at least")
     num = calibration_numerics(p)
     coord = f"{p.coordinate.name}_{p.coordinate.unit}"
     qs, Rs, R_ref = [], [], None

@@ -23,7 +23,7 @@ from typing import Any, Iterable
 from ..parameters import MECHANISMS, ParameterError, ParameterSet
 from ..parameters.base import parse_value
 from ..parameters.options import OPTION_NAMES, OPTION_TYPES, parse_option
-from ..values import is_real
+from ..values import is_real, one_or_many
 
 #: run settings an override may change (``make_spec`` arguments), with their types
 RUN_SETTINGS: dict[str, type] = {
@@ -113,14 +113,13 @@ class Overrides:
 
     @classmethod
     def coerce(cls, value: "Overrides | Iterable[str] | None") -> "Overrides":
-        """An :class:`Overrides` as is; ``NAME=VALUE`` strings parsed; ``None``: none."""
+        """An :class:`Overrides` as is; ``NAME=VALUE`` strings parsed (one string is a list of one,
+        :func:`smafinger.values.one_or_many`); ``None``: none."""
         if value is None:
             return cls()
         if isinstance(value, Overrides):
             return value
-        if isinstance(value, str):
-            raise ParameterError(f"overrides {value!r}: give a list of NAME=VALUE strings")
-        return cls.parse(value)
+        return cls.parse(one_or_many(value))
 
     def then(self, other: "Overrides") -> "Overrides":
         """These overrides followed by ``other`` (``other`` wins where both set a value)."""

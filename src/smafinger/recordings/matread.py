@@ -89,9 +89,9 @@ def open_mat(path, smap: SignalMap) -> MatFile:
         raise RecordingError(f"{path}: a MATLAB v7.3 (HDF5) file, which scipy cannot read; "
                              f"save it with save(..., '-v7')") from None
     except (MatReadError, ValueError, TypeError, IndexError, KeyError, EOFError, OSError, zlib.error,
-            NameError) as exc:
+            UnboundLocalError) as exc:
         # what scipy raises on a file that is not a MAT-file, or is truncated or corrupt (an
-        # UnboundLocalError, a NameError, on some damaged headers: found by an API fuzz)
+        # UnboundLocalError on some damaged headers: found by an API fuzz)
         raise RecordingError(f"{path}: not a readable MATLAB file ({' '.join(str(exc).split())})") from None
     variables = {k: v for k, v in data.items() if not k.startswith("__")}
     header = data.get("__header__", b"")
