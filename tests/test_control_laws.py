@@ -135,3 +135,21 @@ def test_a_calibration_estimates_only_what_it_can():
             calibrate(get("linear-bias-spring"), targets)
     with pytest.raises(ParameterError, match=r"of 2 wire\(s\) has 7 coefficients"):  # 4 fitted the joint exactly
         calibrate(get("paper2010"), (-34.0, -32.0, -30.0, -28.0))
+
+
+def test_none_only_where_it_means_from_the_set():
+    """K_pct, preheat_duty_pct and rate_tau_s took None and failed mid-run (found by an API fuzz);
+    a field whose None means 'derived from the set' still takes it."""
+    from smafinger.control.params import CONTROLLERS, PaperPID
+    from smafinger.parameters import ParameterError
+
+    refused = []
+    for label, cls in CONTROLLERS.items():
+        for name in cls().field_names():
+            try:
+                cls().replace(**{name: None})
+            except ParameterError as exc:
+                assert f"{name} = None: give a number" in str(exc)
+                refused.append(name)
+    assert sorted(refused) == ["K_pct", "preheat_duty_pct", "rate_tau_s"]
+    assert PaperPID().replace(K_P_per_q=None).K_P_per_q is None

@@ -64,8 +64,13 @@ class ControllerParameters:
     def __post_init__(self) -> None:
         for f in fields(self):
             v = getattr(self, f.name)
-            if "range" not in f.metadata or v is None:
+            if "range" not in f.metadata:
                 continue
+            if v is None:
+                if f.default is None:  # None: derived from the parameter set
+                    continue
+                # a field with a value of its own has no None (it failed mid-run: found by an API fuzz)
+                raise ParameterError(f"{self.label}: {f.name} = None: give a number (default {f.default!r})")
             lo, hi = f.metadata["range"]  # checked as a set's fields are (np.float32 was refused)
             object.__setattr__(self, f.name, checked_real(f.name, v, lo, hi, prefix=f"{self.label}: "))
 
