@@ -337,3 +337,21 @@ def test_a_value_is_flat_within_its_bounds_only_if_both_stay_within_a_noise_vari
                                 [3.0, 3.5],    # 3.5 variances, but widened 4x by the correlation: flat
                                 [0.0, 0.0]])   # already not determined: left to the other rule
     assert flat_within_bounds(at_bounds, sse, cov).tolist() == [True, False, True, False]
+
+
+@pytest.mark.parametrize("change, words", [
+    (dict(max_nfev=0), "max_nfev = 0 must be a whole number >= 1"),
+    (dict(max_nfev=1.5), "max_nfev = 1.5 must be a whole number"),
+    (dict(budget=-1), "budget = -1 must be a whole number >= 0"),
+    (dict(popsize=1), "popsize = 1 must be a whole number >= 2"),
+    (dict(sigma0=0.0), r"sigma0 = 0.0 must be a number in \(0, 1\]"),
+    (dict(diff_step=0.0), r"diff_step = 0.0 must be a number in \(0, 0.5\]"),
+    (dict(dt_s=float("nan")), r"dt_s = nan must be a number in \(0, 1\]"),
+])
+def test_fit_settings_name_what_the_stages_cannot_use(change, words):
+    """Found by an API fuzz: max_nfev 0 was an AttributeError, sigma0 0 a division by zero inside
+    cma, a diff_step of 0 reported a parameter as not determined, max_nfev 1.5 no budget at all."""
+    from smafinger.analysis.actuator_fit import FitSettings
+
+    with pytest.raises(ValueError, match=words):
+        FitSettings(**change)

@@ -75,6 +75,8 @@ class Evaluator:
     def __init__(self, runs: Sequence[BenchRun], box: FreeBox, pool, fit_offsets: bool = True,
                  dt_s: float = DEFAULT_DT_S, on_sim: Callable[[int], None] | None = None):
         self.runs, self.box, self.pool = tuple(runs), box, pool
+        if not self.runs:  # numpy's concatenate said so (found by an API fuzz)
+            raise ValueError("no run to fit: give one bench run at least")
         self.fit_offsets, self.dt_s, self.on_sim = fit_offsets, dt_s, on_sim
         self.column = coordinate_column(box.base)
         sizes = [r.n_samples for r in self.runs]

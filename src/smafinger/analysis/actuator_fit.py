@@ -33,6 +33,7 @@ from scipy.optimize import least_squares
 
 from ..engine.defaults import DEFAULT_DT_S, FIT_BUDGET, FIT_MAX_NFEV, FIT_SEED
 from ..parameters import ParameterSet
+from ..values import is_real, is_whole
 from .actuator_eval import Evaluator
 from .bench_runs import BenchRun
 from .fit_uncertainty import (DETERMINED_CHI2, UNDETERMINED_WIDTHS, Covariance, covariance, flat_within_bounds,
@@ -89,6 +90,21 @@ class FitSettings:
     diff_step: float = 1e-2
     dt_s: float = DEFAULT_DT_S
     fit_offsets: bool = True
+
+    def __post_init__(self) -> None:
+        """ValueError naming a setting the two stages cannot use (found by an API fuzz: max_nfev 0
+        an AttributeError, sigma0 0 a division by zero in cma, a diff_step of 0 a parameter
+        reported 'not determined', a max_nfev of 1.5 no budget at all)."""
+        for name, lo in (("budget", 0), ("max_nfev", 1), ("seed", 0)):
+            v = getattr(self, name)
+            if not (is_whole(v) and v >= lo):
+                raise ValueError(f"fit settings: {name} = {v!r} must be a whole number >= {lo}")
+        if self.popsize is not None and not (is_whole(self.popsize) and self.popsize >= 2):
+            raise ValueError(f"fit settings: popsize = {self.popsize!r} must be a whole number >= 2 (or None)")
+        for name, hi in (("sigma0", 1.0), ("diff_step", 0.5), ("dt_s", 1.0)):
+            v = getattr(self, name)
+            if not (is_real(v) and 0.0 < v <= hi):
+                raise ValueError(f"fit settings: {name} = {v!r} must be a number in (0, {hi:g}]")
 
 
 @dataclass
