@@ -355,3 +355,12 @@ def test_fit_settings_name_what_the_stages_cannot_use(change, words):
 
     with pytest.raises(ValueError, match=words):
         FitSettings(**change)
+
+
+def test_one_free_option_is_a_list_of_one():
+    """parse_free(p, "A_S0_C") read the option 'A' (found by an API fuzz)."""
+    from smafinger.analysis.free_params import parse_free
+    from smafinger.parameters import get
+
+    p = get("linear-bias-spring")
+    assert parse_free(p, "A_S0_C") == parse_free(p, ["A_S0_C"])

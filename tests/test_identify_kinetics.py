@@ -267,3 +267,27 @@ def test_a_closed_stdout_does_not_cost_the_fit(real_curves, tmp_path):
     err = p.stderr.read().decode()
     assert (p.wait(), err) == (141, "")
     assert out.stat().st_size > 0 and rep.stat().st_size > 0
+
+
+def test_a_curve_or_a_setting_the_kinetics_fit_cannot_use_is_refused_by_name():
+    """Found by an API fuzz: a split past the end was an IndexError, a NaN strain 'initial guess
+    outside the bounds', lengths that differ a broadcasting error, fit_moduli="D_M" the names
+    D, M and _, and max_nfev=1.5 no budget at all."""
+    from smafinger.analysis.data import DataError, StrainCurve
+    from smafinger.analysis.kinetics_fit import fit_kinetics
+
+    T = np.linspace(20.0, 120.0, 20)
+    eps = np.linspace(0.0, 0.04, 20)
+    sigma = np.full(20, 1e8)
+    for kw, words in ((dict(split=20), "split = 20 is not a row of the curve"),
+                      (dict(split=-1), "split = -1 is not a row"),
+                      (dict(strain=np.r_[eps[:-1], np.nan]), "strain has a non-finite sample at row 19"),
+                      (dict(T_C=T[:-1]), "must be 1-D arrays of one length")):
+        with pytest.raises(DataError, match=words):
+            StrainCurve(**{"path": "c.csv", "T_C": T, "strain": eps, "stress_Pa": sigma, "split": 10, **kw})
+    curve = StrainCurve("c.csv", T, eps, sigma, 10)
+    with pytest.raises(ValueError, match="max_nfev = 1.5 must be a whole number"):
+        fit_kinetics([curve], get("paper2010"), max_nfev=1.5)
+    from smafinger.analysis.kinetics_fit import _free_mask
+
+    assert (_free_mask("D_M") == _free_mask(("D_M",))).all()

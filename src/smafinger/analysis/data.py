@@ -36,6 +36,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..values import is_whole
+
 if TYPE_CHECKING:
     from ..parameters import ParameterSet
 
@@ -127,6 +129,21 @@ class StrainCurve:
     strain: np.ndarray  #: the file's values shifted to a minimum of 0 (the sensor's zero; the fit adds an offset)
     stress_Pa: np.ndarray
     split: int  # row index of the maximum temperature (last row of the heating half)
+
+    def __post_init__(self) -> None:
+        """A curve built in Python has 1-D finite samples of one length and a split inside them
+        (an IndexError or numpy's errors came from inside the fit: found by an API fuzz). The
+        file reader says more, with the row."""
+        arrays = {name: np.asarray(getattr(self, name)) for name in ("T_C", "strain", "stress_Pa")}
+        shapes = {a.shape for a in arrays.values()}
+        if len(shapes) != 1 or arrays["T_C"].ndim != 1 or arrays["T_C"].size == 0:
+            raise DataError(f"{self.path}: T_C, strain and stress_Pa must be 1-D arrays of one length, with "
+                            f"samples (shapes {', '.join(str(a.shape) for a in arrays.values())})")
+        for name, a in arrays.items():
+            if not np.all(np.isfinite(a)):
+                raise DataError(f"{self.path}: {name} has a non-finite sample at row {int(np.flatnonzero(~np.isfinite(a))[0])}")
+        if not (is_whole(self.split) and 0 <= self.split < arrays["T_C"].size):
+            raise DataError(f"{self.path}: split = {self.split!r} is not a row of the curve (0 to {arrays['T_C'].size - 1})")
 
     @property
     def name(self) -> str:

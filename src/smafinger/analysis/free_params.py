@@ -28,6 +28,7 @@ import numpy as np
 
 from ..parameters import ParameterError, ParameterSet
 from ..parameters.mechanisms import JointParameters, LinearActuatorParameters
+from ..values import one_or_many
 
 #: (lower, upper) fields that must stay ordered: each transformation's start and finish, and
 #: the major loop not empty at zero stress (M_F0 < A_S0, M_S0 < A_F0: a set is refused otherwise)
@@ -169,7 +170,7 @@ def parse_free(p: ParameterSet, options: list[str] | None) -> tuple[FreeParamete
     if not options:
         return tuple(make_free(p, r.name) for r in DEFAULT_FREE[p.mechanism])
     out: list[FreeParameter] = []
-    for opt in options:
+    for opt in one_or_many(options):  # one option is a list of one (it was read letter by letter)
         parts = [s.strip() for s in opt.split(":")]
         if len(parts) not in (1, 3) or not parts[0]:
             raise FreeParameterError(f"--free {opt!r}: expected NAME or NAME:LO:HI, e.g. A_S0_C:55:85")

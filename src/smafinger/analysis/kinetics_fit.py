@@ -51,6 +51,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..parameters import ParameterSet
+from ..values import is_whole, one_or_many
 from .data import StrainCurve
 # the model, the starting values and the figure live in their own modules; their public names
 # are re-exported here, where callers import them from
@@ -108,6 +109,7 @@ class KineticsFit:
 
 
 def _free_mask(fit_moduli: Sequence[str]) -> np.ndarray:
+    fit_moduli = one_or_many(fit_moduli)  # "D_M" is one name, not D, _ and M (found by an API fuzz)
     free = np.ones(len(X_NAMES), dtype=bool)
     for name in ("D_M", "D_A"):
         if name not in fit_moduli:
@@ -129,6 +131,8 @@ def fit_kinetics(curves: Sequence[StrainCurve], base: ParameterSet | KineticPara
     """
     if not curves:
         raise ValueError("no curves to fit")
+    if not (is_whole(max_nfev) and max_nfev >= 1):  # 1.5 was no budget at all (found by an API fuzz)
+        raise ValueError(f"max_nfev = {max_nfev!r} must be a whole number >= 1")
     base_kp = base if isinstance(base, KineticParams) else KineticParams.from_set(base)
     init, free, notes = _fit_start(curves, base_kp, fit_moduli)
     x_all = np.clip(init._x(), X_LO + 1e-9, X_HI - 1e-9)
