@@ -197,7 +197,7 @@ def test_the_joint_fit_refuses_what_it_cannot_fit(tmp_path):
             synthesize(TRUTH, "0:5:0", **{"t_end_s": 2.0, **kw})
     with pytest.raises(ValueError, match="t_s has no samples"):
         simulate_angle(TRUTH, VoltageProgram.parse("0:5:0"), np.array([]))
-    with pytest.raises(DataError, match=r"sample 2 is not finite \(t = 0.2 s, angle = nan deg\)"):
+    with pytest.raises(DataError, match=r"angle_deg has a non-finite sample at row 2 \(nan\)"):
         AngleCurve("bench", np.array([0.0, 0.1, 0.2]), np.array([0.0, -1.0, np.nan]))
     with pytest.raises(DataError, match="with samples"):
         AngleCurve("bench", np.array([]), np.array([]))

@@ -131,19 +131,10 @@ class StrainCurve:
     split: int  # row index of the maximum temperature (last row of the heating half)
 
     def __post_init__(self) -> None:
-        """A curve built in Python has 1-D finite samples of one length and a split inside them
-        (an IndexError or numpy's errors came from inside the fit: found by an API fuzz). The
-        file reader says more, with the row."""
-        arrays = {name: np.asarray(getattr(self, name)) for name in ("T_C", "strain", "stress_Pa")}
-        shapes = {a.shape for a in arrays.values()}
-        if len(shapes) != 1 or arrays["T_C"].ndim != 1 or arrays["T_C"].size == 0:
-            raise DataError(f"{self.path}: T_C, strain and stress_Pa must be 1-D arrays of one length, with "
-                            f"samples (shapes {', '.join(str(a.shape) for a in arrays.values())})")
-        for name, a in arrays.items():
-            if not np.all(np.isfinite(a)):
-                raise DataError(f"{self.path}: {name} has a non-finite sample at row {int(np.flatnonzero(~np.isfinite(a))[0])}")
-        if not (is_whole(self.split) and 0 <= self.split < arrays["T_C"].size):
-            raise DataError(f"{self.path}: split = {self.split!r} is not a row of the curve (0 to {arrays['T_C'].size - 1})")
+        """Checked as :func:`_samples` says, and a split inside the samples."""
+        n = _samples(self, "T_C", "strain", "stress_Pa")
+        if not (is_whole(self.split) and 0 <= self.split < n):
+            raise DataError(f"{self.path}: split = {self.split!r} is not a row of the curve (0 to {n - 1})")
 
     @property
     def name(self) -> str:
@@ -257,6 +248,23 @@ def _check_transformation(path, T: np.ndarray, e: np.ndarray, split: int) -> Non
                         "temperatures on heating (rows must heat first, then cool)")
 
 
+def _samples(curve, *names: str) -> int:
+    """The number of samples of a curve built in Python, whose fields ``names`` must be 1-D
+    finite arrays of one length with samples (an IndexError or numpy's errors came from inside
+    the fits: found by an API fuzz); :class:`DataError` naming the field otherwise. The file
+    readers say more, with the row."""
+    arrays = {name: np.asarray(getattr(curve, name)) for name in names}
+    shapes = [a.shape for a in arrays.values()]
+    if len(set(shapes)) != 1 or len(shapes[0]) != 1 or shapes[0][0] == 0:
+        raise DataError(f"{curve.path}: {', '.join(names)} must be 1-D arrays of one length, with samples "
+                        f"(shapes {', '.join(map(str, shapes))})")
+    for name, a in arrays.items():
+        if not np.all(np.isfinite(a)):
+            k = int(np.flatnonzero(~np.isfinite(a))[0])
+            raise DataError(f"{curve.path}: {name} has a non-finite sample at row {k} ({float(a[k])!r})")
+    return shapes[0][0]
+
+
 # ---------------------------------------------------------------------------------------
 # angle-vs-time curves
 # ---------------------------------------------------------------------------------------
@@ -270,17 +278,9 @@ class AngleCurve:
     voltage_V: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        """A curve built in Python has samples, all finite (a NaN angle made every residual the
-        fit's failure value, and the fit reported success: found by an API fuzz). The file
-        readers say more, with the row."""
-        t, a = np.asarray(self.t_s), np.asarray(self.angle_deg)
-        if t.ndim != 1 or t.shape != a.shape or t.size == 0:
-            raise DataError(f"{self.path}: t_s and angle_deg must be 1-D arrays of one length, with samples "
-                            f"(shapes {t.shape} and {a.shape})")
-        bad = ~(np.isfinite(t) & np.isfinite(a))
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            raise DataError(f"{self.path}: sample {k} is not finite (t = {float(t[k])!r} s, angle = {float(a[k])!r} deg)")
+        """Checked as :func:`_samples` says (a NaN angle made every residual the fit's failure
+        value, and the fit reported success)."""
+        _samples(self, "t_s", "angle_deg")
 
     @property
     def name(self) -> str:
